@@ -11,9 +11,12 @@ Theories
 Percolation is exact: critical junction gives σ_eff = 0 when A(ζ1)/A0 >= a_perc; the
 effective medium when A(ζ1)/A0 >= 0.5. Every result carries a ``percolated`` flag.
 
-The effective medium integral is taken in the variable A (``-A'(ζ)dζ = -dA``) with
-Gauss–Legendre nodes on [A(ζ1), 1], u1 evaluated at the magnification where A(ζ) equals
-each node exactly; nodes where dA/dζ underflows get u1 = ∞ and so contribute 0 (masked).
+The effective medium integral is taken in the variable A (``-A'(ζ)dζ = -dA``) on
+[A(ζ1), 1], graded towards both ends (t -> A = A1 + (1-A1) t³/(t³+(1-t)³)), with adaptive
+Gauss–Kronrod (7/15) panels: the panel with the largest Kronrod–Gauss difference of the
+Bruggeman residual is split until the estimated relative error of σ̄ is below EMT_TOL.
+u1 is evaluated where A(ζ) equals each node exactly; nodes where dA/dζ underflows get
+u1 = ∞ and contribute 0 (masked, never inf/NaN in the result).
 """
 from __future__ import annotations
 
@@ -27,11 +30,11 @@ from .contact import _arrays, _check_gamma, _check_psd
 from .quadrature import PANEL, gauss_legendre, u1_at_area, m1_above
 from .special import k_table
 
-__all__ = ["THEORIES", "conductivity", "flow_factor", "EMT_N_AREA"]
+__all__ = ["THEORIES", "conductivity", "flow_factor", "sigma_bar"]
 
 THEORIES = ("average", "critical_junction", "emt")
-#: Gauss–Legendre nodes in A for the effective-medium integral (see bench/bench_tables.py)
-EMT_N_AREA = 96
+#: initial Gauss–Kronrod panels of the adaptive effective-medium integral over A
+EMT_N_START = 4
 #: Gauss–Hermite nodes for the Almqvist-broadened P(u)
 GH_ORDER = 24
 
@@ -67,6 +70,55 @@ def critical_junction_kernel(qb, c, e, cum3, kinks, pbar, gamma, a_perc, ktab, g
             percolated[i] = False
 
 
+_XGK = np.array([-0.991455371120812639206854697526329, -0.949107912342758524526189684047851,
+                 -0.864864423359769072789712788640926, -0.741531185599394439863864773280788,
+                 -0.586087235467691130294144845693013, -0.405845151377397166906606412076961,
+                 -0.207784955007898467600689403773245, 0.0,
+                 0.207784955007898467600689403773245, 0.405845151377397166906606412076961,
+                 0.586087235467691130294144845693013, 0.741531185599394439863864773280788,
+                 0.864864423359769072789712788640926, 0.949107912342758524526189684047851,
+                 0.991455371120812639206854697526329])
+_WGK = np.array([0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
+                 0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
+                 0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
+                 0.204432940075298892414161999234649, 0.209482141084727828012999174891714,
+                 0.204432940075298892414161999234649, 0.190350578064785409913256402421014,
+                 0.169004726639267902826583426598550, 0.140653259715525918745189590510238,
+                 0.104790010322250183839876322541518, 0.063092092629978553290700663189204,
+                 0.022935322010529224963732008058970])
+_WG7 = np.array([0.0, 0.129484966168869693270611432679082, 0.0, 0.279705391489276667901467771423780,
+                 0.0, 0.381830050505118944950369775488975, 0.0, 0.417959183673469387755102040816327,
+                 0.0, 0.381830050505118944950369775488975, 0.0, 0.279705391489276667901467771423780,
+                 0.0, 0.129484966168869693270611432679082, 0.0])
+#: target relative accuracy of the effective-medium σ̄ (adaptive quadrature in A)
+EMT_TOL = 1e-8
+EMT_MAX_PANELS = 96
+#: grading exponent of the map t -> A that clusters nodes at both ends of [A(ζ1), 1]
+EMT_GRADE = 3.0
+
+
+@njit(cache=True)
+def _node_terms(s, sj, hzj, almqvist, ghx, ghw):
+    """(Σ 2r, Σ 2r(1-r)) of one node, r = s/(s + σ(u)); Gauss–Hermite average if almqvist."""
+    if sj == math.inf:
+        return 0.0, 0.0  # masked: u1 undefined where dA/dζ = 0; zero weight
+    if not almqvist:
+        if sj == 0.0:
+            return 2.0, 0.0
+        r = s / (s + sj)
+        return 2.0 * r, 2.0 * r * (1.0 - r)
+    mu = sj ** (1.0 / 3.0)
+    acc = 0.0
+    dacc = 0.0
+    for k in range(ghx.size):
+        u = abs(mu + math.sqrt(2.0) * hzj * ghx[k])
+        su = u * u * u
+        r = s / (s + su) if s + su > 0.0 else 1.0
+        acc += ghw[k] * 2.0 * r
+        dacc += ghw[k] * 2.0 * r * (1.0 - r)
+    return acc / math.sqrt(math.pi), dacc / math.sqrt(math.pi)
+
+
 @njit(cache=True)
 def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw):
     """Solve Σ_j W_j 2s/(s + σ_j) + 2 A1 - 1 = 0 for s > 0 (2-D Bruggeman, reduced units).
@@ -76,25 +128,23 @@ def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw):
     """
     if A1 >= 0.5:
         return 0.0
-    # bracket in y = ln s
     inv = 0.0
     smax = 0.0
     for j in range(W.size):
-        if sig[j] > 0.0:
-            inv += W[j] / sig[j]
-            if sig[j] > smax and sig[j] < math.inf:
-                smax = sig[j]
-    if almqvist:
-        # widths broaden the distribution: widen the bracket generously
-        for j in range(W.size):
-            if sig[j] == math.inf:
-                continue
-            u = sig[j] ** (1.0 / 3.0) + 8.0 * hz[j]
-            if u ** 3 > smax:
-                smax = u ** 3
+        sj = sig[j]
+        if sj == math.inf:
+            continue
+        if almqvist:
+            sj = (sj ** (1.0 / 3.0) + 8.0 * hz[j]) ** 3
+        if sj > 0.0:
+            inv += W[j] / sig[j] if sig[j] > 0.0 else 0.0
+            if sj > smax:
+                smax = sj
     if smax <= 0.0:
         return 0.0
     lo = math.log(max((1.0 - 2.0 * A1) / (2.0 * inv) if inv > 0 else smax * 1e-300, 1e-300)) - 1.0
+    if almqvist:
+        lo -= 30.0
     hi = math.log(smax) + 1.0
     y = 0.5 * (lo + hi)
     for it in range(200):
@@ -102,28 +152,9 @@ def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw):
         f = 2.0 * A1 - 1.0
         df = 0.0
         for j in range(W.size):
-            if sig[j] == math.inf:
-                continue  # masked node (u1 undefined, dA/dζ = 0): zero weight
-            if almqvist:
-                mu = sig[j] ** (1.0 / 3.0)
-                acc = 0.0
-                dacc = 0.0
-                for k in range(ghx.size):
-                    u = abs(mu + math.sqrt(2.0) * hz[j] * ghx[k])
-                    su = u * u * u
-                    r = s / (s + su) if s + su > 0.0 else 1.0
-                    acc += ghw[k] * 2.0 * r
-                    dacc += ghw[k] * 2.0 * r * (1.0 - r)
-                f += W[j] * acc / math.sqrt(math.pi)
-                df += W[j] * dacc / math.sqrt(math.pi)
-            else:
-                sj = sig[j]
-                if sj == 0.0:
-                    f += 2.0 * W[j]  # a node in contact: σ(u = 0) = 0
-                    continue
-                r = s / (s + sj)
-                f += W[j] * 2.0 * r
-                df += W[j] * 2.0 * r * (1.0 - r)
+            t1, t2 = _node_terms(s, sig[j], hz[j], almqvist, ghx, ghw)
+            f += W[j] * t1
+            df += W[j] * t2
         if f > 0.0:
             hi = y
         else:
@@ -137,40 +168,117 @@ def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw):
     return math.exp(y)
 
 
-@njit(cache=True, parallel=True)
-def emt_kernel(qb, c, e, cum3, kinks, pbar, h_rms, gamma, ktab, glx, glw, panel, ax, aw,
-               almqvist, ghx, ghw, sigma, percolated):
-    """Bruggeman σ̄ = 12ησ_eff/h_rms³ per reduced pressure (u1-based P(u), SPEC §3)."""
-    n = ax.size
-    for i in prange(pbar.size):
-        A1 = _area1(cum3, pbar[i])
-        if A1 >= 0.5:
-            sigma[i] = 0.0
-            percolated[i] = True
+@njit(cache=True)
+def _emt_fill_panel(qb, c, e, cum3, kinks, pbar, A1, t0, t1, h_rms, gamma, ktab, glx, glw, panel,
+                    almqvist, work, sig, hz, WK, WG, off):
+    """u1-based σ(u) at the 15 Kronrod nodes of panel [t0, t1] of the graded variable t."""
+    m = EMT_GRADE
+    half = 0.5 * (t1 - t0)
+    mid = 0.5 * (t1 + t0)
+    for k in range(15):
+        t = mid + half * _XGK[k]
+        tm = t ** m
+        om = (1.0 - t) ** m
+        sfrac = tm / (tm + om)
+        ds = m * (t * (1.0 - t)) ** (m - 1.0) / (tm + om) ** 2
+        area = A1 + (1.0 - A1) * sfrac
+        WK[off + k] = (1.0 - A1) * ds * half * _WGK[k]
+        WG[off + k] = (1.0 - A1) * ds * half * _WG7[k]
+        if area >= 1.0 or area <= A1:
+            sig[off + k] = math.inf
+            hz[off + k] = 0.0
             continue
-        percolated[i] = False
-        work = np.empty(3)
-        W = np.empty(n)
-        sig = np.empty(n)
-        hz = np.zeros(n)
-        for j in range(n):
-            area = A1 + (1.0 - A1) * 0.5 * (1.0 + ax[j])
-            W[j] = (1.0 - A1) * 0.5 * aw[j]
-            u, a = u1_at_area(qb, c, e, cum3, kinks, area, pbar[i], gamma, ktab, glx, glw,
-                              panel, work)
-            if not (u < math.inf) or u != u:
-                sig[j] = math.inf  # masked: dA/dζ = 0 there, zero weight in the integral
-            else:
-                uh = max(u, 0.0) / h_rms
-                sig[j] = uh * uh * uh
-            if almqvist:
-                hz[j] = math.sqrt(2.0 * math.pi * m1_above(qb, c, e, a)) / h_rms
-        sigma[i] = bruggeman(W, sig, A1, almqvist, hz, ghx, ghw)
+        u, a = u1_at_area(qb, c, e, cum3, kinks, area, pbar, gamma, ktab, glx, glw, panel, work)
+        if not (u < math.inf) or u != u:
+            sig[off + k] = math.inf  # masked: dA/dζ = 0 there
+        else:
+            uh = max(u, 0.0) / h_rms
+            sig[off + k] = uh * uh * uh
+        hz[off + k] = math.sqrt(2.0 * math.pi * m1_above(qb, c, e, a)) / h_rms if almqvist else 0.0
+
+
+@njit(cache=True)
+def emt_sigma(qb, c, e, cum3, kinks, pbar, h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx,
+              ghw, n_start, tol):
+    """Bruggeman σ̄ at one reduced pressure with adaptive Gauss–Kronrod panels in A.
+
+    Returns (σ̄, estimated relative error, number of u1 evaluations).
+    """
+    A1 = _area1(cum3, pbar)
+    if A1 >= 0.5:
+        return 0.0, 0.0, 0
+    cap = EMT_MAX_PANELS * 15
+    sig = np.empty(cap)
+    hz = np.zeros(cap)
+    WK = np.empty(cap)
+    WG = np.empty(cap)
+    pt0 = np.empty(EMT_MAX_PANELS)
+    pt1 = np.empty(EMT_MAX_PANELS)
+    work = np.empty(3)
+    npan = n_start
+    for k in range(npan):
+        pt0[k] = k / npan
+        pt1[k] = (k + 1) / npan
+        _emt_fill_panel(qb, c, e, cum3, kinks, pbar, A1, pt0[k], pt1[k], h_rms, gamma, ktab, glx,
+                        glw, panel, almqvist, work, sig, hz, WK, WG, 15 * k)
+    s = 0.0
+    est = 0.0
+    while True:
+        n = 15 * npan
+        s = bruggeman(WK[:n], sig[:n], A1, almqvist, hz[:n], ghx, ghw)
+        if s <= 0.0:
+            return 0.0, 0.0, n
+        # per-panel error of the Bruggeman residual, relative to d f / d ln s
+        dfl = 0.0
+        worst = -1
+        worst_err = 0.0
+        tot = 0.0
+        for k in range(npan):
+            ek = 0.0
+            eg = 0.0
+            for j in range(15 * k, 15 * k + 15):
+                t1_, t2_ = _node_terms(s, sig[j], hz[j], almqvist, ghx, ghw)
+                ek += WK[j] * t1_
+                eg += WG[j] * t1_
+                dfl += WK[j] * t2_
+            err = abs(ek - eg)
+            tot += err
+            if err > worst_err:
+                worst_err = err
+                worst = k
+        est = tot / dfl if dfl > 0.0 else 0.0
+        if est <= tol or npan >= EMT_MAX_PANELS or worst < 0:
+            return s, est, n
+        # split the worst panel: its left half replaces it, the right half is appended
+        a0 = pt0[worst]
+        a1 = pt1[worst]
+        am = 0.5 * (a0 + a1)
+        pt1[worst] = am
+        _emt_fill_panel(qb, c, e, cum3, kinks, pbar, A1, a0, am, h_rms, gamma, ktab, glx, glw,
+                        panel, almqvist, work, sig, hz, WK, WG, 15 * worst)
+        pt0[npan] = am
+        pt1[npan] = a1
+        _emt_fill_panel(qb, c, e, cum3, kinks, pbar, A1, am, a1, h_rms, gamma, ktab, glx, glw,
+                        panel, almqvist, work, sig, hz, WK, WG, 15 * npan)
+        npan += 1
+
+
+@njit(cache=True, parallel=True)
+def emt_kernel(qb, c, e, cum3, kinks, pbar, h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx,
+               ghw, n_start, tol, sigma, percolated, err, nevals):
+    """Bruggeman σ̄ = 12ησ_eff/h_rms³ per reduced pressure (u1-based P(u), SPEC §3)."""
+    for i in prange(pbar.size):
+        percolated[i] = _area1(cum3, pbar[i]) >= 0.5
+        s, es, ne = emt_sigma(qb, c, e, cum3, kinks, pbar[i], h_rms, gamma, ktab, glx, glw, panel,
+                              almqvist, ghx, ghw, n_start, tol)
+        sigma[i] = s
+        err[i] = es
+        nevals[i] = ne
 
 
 # --------------------------------------------------------------------------- reduced API
-def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_area=EMT_N_AREA,
-              almqvist=False, glx=None, glw=None, panel=PANEL):
+def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start=EMT_N_START,
+              tol=EMT_TOL, almqvist=False, glx=None, glw=None, panel=PANEL):
     """Reduced conductivity σ̄ = 12ησ_eff/h_rms³ at reduced contact pressures p̄ = p/E*.
 
     Returns (sigma_bar, percolated, extra) with extra = dict of by-products (u_bar, u1c, ζc).
@@ -198,18 +306,21 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_area=
         extra["zeta_c"] = zc
         return (alpha_cj * u1c / h) ** 3, perc, extra
     if theory == "emt":
-        ax, aw = np.polynomial.legendre.leggauss(int(n_area))
         ghx, ghw = np.polynomial.hermite.hermgauss(GH_ORDER)
         sig = np.empty(pbar.size)
         perc = np.empty(pbar.size, dtype=np.bool_)
-        emt_kernel(*arrs, pbar, h, gamma, ktab, glx, glw, float(panel), ax, aw, bool(almqvist),
-                   ghx, ghw, sig, perc)
+        err = np.empty(pbar.size)
+        nev = np.empty(pbar.size, dtype=np.int64)
+        emt_kernel(*arrs, pbar, h, gamma, ktab, glx, glw, float(panel), bool(almqvist), ghx, ghw,
+                   int(n_start), float(tol), sig, perc, err, nev)
+        extra["error_estimate"] = err
+        extra["u1_evaluations"] = nev
         return sig, perc, extra
     check_theory(theory)
 
 
 def conductivity(psd, p, E_star, eta, theory="average", *, gamma=1.0, a_perc=0.5,
-                 alpha_cj=1.0, n_area=EMT_N_AREA, almqvist=False):
+                 alpha_cj=1.0, tol=EMT_TOL, almqvist=False):
     """Effective interfacial fluid conductivity σ_eff(p_cont) [m³/(Pa·s)] by direct quadrature.
 
     Parameters
@@ -222,7 +333,7 @@ def conductivity(psd, p, E_star, eta, theory="average", *, gamma=1.0, a_perc=0.5
     gamma : float      Yang–Persson factor of ū(ζ) and u1(ζ) (1 = paper)
     a_perc : float     critical-junction percolation area fraction (0.5 paper; 0.42 option)
     alpha_cj : float   critical-junction factor multiplying u1(ζc) (σ carries α_cj³)
-    n_area : int       Gauss–Legendre nodes of the effective-medium integral over A
+    tol : float        target relative accuracy of the adaptive effective-medium integral
     almqvist : bool    Gaussian-broadened P(u) (Almqvist et al. 2011) in the effective medium
 
     Returns
@@ -239,7 +350,7 @@ def conductivity(psd, p, E_star, eta, theory="average", *, gamma=1.0, a_perc=0.5
     a_perc = float(check_range("a_perc", a_perc, 0.0, 1.0, "[-]", lo_open=True, hi_open=True))
     alpha_cj = float(check_positive("alpha_cj", alpha_cj, "[-]"))
     sb, perc, _ = sigma_bar(psd, np.ravel(p) / E_star, theory, gamma=gamma, a_perc=a_perc,
-                            alpha_cj=alpha_cj, n_area=n_area, almqvist=almqvist)
+                            alpha_cj=alpha_cj, tol=tol, almqvist=almqvist)
     sig = sb.reshape(np.shape(p)) * psd.h_rms ** 3 / (12.0 * eta)
     return sig, perc.reshape(np.shape(p))
 

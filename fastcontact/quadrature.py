@@ -36,6 +36,9 @@ GL_ORDER = 10
 PANEL = 1.0
 #: s0² above which the integrands are negligible (e^{-64} ~ 1.6e-28)
 S2_CUT = 64.0
+#: panel grading: width = PANEL * clip(distance to the nearest feature / GRADE, 1, GRADE_MAX)
+GRADE = 2.5
+GRADE_MAX = 8.0
 TAU_FLOOR = -300.0
 
 SQRT_PI = math.sqrt(math.pi)
@@ -171,7 +174,10 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
         tau_lo -= 1.0
     if tau_lo < TAU_FLOOR:
         tau_lo = TAU_FLOOR
-    # panels, split at kinks
+    # panels, graded: width `panel` near the two features of the integrands (s0 ~ 1 at
+    # tau_1, and q - a ~ a at tau = 0), growing to GRADE_MAX * panel away from them where
+    # the integrands are smooth exponentials in tau; split at kinks
+    tau_1 = math.log(P * P / (math.pi * a ** 4 * ca))
     nk = kinks.size
     t0 = tau_lo
     sF = 0.0
@@ -179,7 +185,9 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
     sJ = 0.0
     ng = glx.size
     while t0 < tau_hi:
-        t1 = t0 + panel
+        dist = min(abs(t0 - tau_1), abs(t0))
+        width = panel * min(max(1.0, dist / GRADE), GRADE_MAX)
+        t1 = t0 + width
         if t1 > tau_hi:
             t1 = tau_hi
         for ik in range(nk):

@@ -40,7 +40,7 @@ from numba import njit
 
 from . import __version__
 from ._validate import check_positive, check_range
-from .conductivity import EMT_N_AREA, THEORIES, check_theory, sigma_bar
+from .conductivity import EMT_TOL, THEORIES, check_theory, sigma_bar
 from .contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
 from .grids import Grid, build_bucket_map, hermite_interval, locate_asc, locate_desc
 from .psd import PSD, psd_from_dict
@@ -50,7 +50,7 @@ __all__ = ["Tables", "precompute", "DEFAULT_POINTS_PER_DECADE", "SCHEMA_VERSION"
 SCHEMA_VERSION = 1
 METADATA_KEY = b"fastcontact"
 #: default grid density in p̄ (chosen from bench/bench_tables.py, see bench/RESULTS.md)
-DEFAULT_POINTS_PER_DECADE = 16
+DEFAULT_POINTS_PER_DECADE = 8
 #: the table reaches from ū = U_TOP h_rms ...
 U_TOP = 32.0
 #: ... to A(ζ1)/A0 = AREA_TOP
@@ -190,7 +190,7 @@ def _column_digest(data: dict) -> str:
     return h.hexdigest()
 
 
-def _theory_options(theories, gamma, a_perc, alpha_cj, emt_n_area, emt_almqvist):
+def _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist):
     if isinstance(theories, str):
         theories = (theories,)
     theories = tuple(dict.fromkeys(check_theory(t) for t in theories))
@@ -201,7 +201,7 @@ def _theory_options(theories, gamma, a_perc, alpha_cj, emt_n_area, emt_almqvist)
         "gamma": _check_gamma(gamma),
         "a_perc": float(check_range("a_perc", a_perc, 0.0, 1.0, "[-]", lo_open=True, hi_open=True)),
         "alpha_cj": float(check_positive("alpha_cj", alpha_cj, "[-]")),
-        "emt_n_area": int(check_range("emt_n_area", emt_n_area, 8, 4096, "[nodes]")),
+        "emt_tol": float(check_range("emt_tol", emt_tol, 1e-13, 1e-2, "[-]")),
         "emt_almqvist": bool(emt_almqvist),
     }
 
@@ -492,18 +492,20 @@ def _exact(psd, pbar, theories, sig_opts):
 
 
 def _node_derivative(x, y, ok):
-    """d y/d x at each node from the local degree-4 polynomial through the 5 nearest open nodes."""
+    """d y/d x at the open nodes from the degree-4 polynomial through the 5 nearest open nodes."""
     d = np.zeros_like(y)
     idx = np.flatnonzero(ok)
     m = idx.size
-    for k in range(m):
-        lo = min(max(k - 2, 0), max(m - 5, 0))
-        sel = idx[lo:lo + 5]
-        if sel.size < 2:
-            continue
-        xs = x[sel] - x[idx[k]]
-        coef = np.polyfit(xs, y[sel], min(4, sel.size - 1))
-        d[idx[k]] = coef[-2]
+    if m < 2:
+        return d
+    w = min(5, m)
+    k = np.arange(m)
+    lo = np.clip(k - w // 2, 0, m - w)
+    sten = idx[lo[:, None] + np.arange(w)[None, :]]            # (m, w) node indices
+    dx = x[sten] - x[idx][:, None]                             # local abscissae
+    V = dx[:, :, None] ** np.arange(w)[None, None, :]          # Vandermonde (m, w, w)
+    coef = np.linalg.solve(V, y[sten][:, :, None])[:, :, 0]
+    d[idx] = coef[:, 1]
     return d
 
 
@@ -540,7 +542,7 @@ def _interval_errors(lnp, cols, mids, theories):
 
 
 def precompute(psd, theories=("average", "critical_junction", "emt"), gamma=1.0, a_perc=0.5,
-               alpha_cj=1.0, grid=None, *, emt_n_area=EMT_N_AREA, emt_almqvist=False,
+               alpha_cj=1.0, grid=None, *, emt_tol=EMT_TOL, emt_almqvist=False,
                points_per_decade=None, tolerance=None, refine=True):
     """Tabulate ū, A, u1(ζc), σ̄ and φ_p of a surface on a log grid of p̄ = p/E* (SPEC §2–3).
 
@@ -557,7 +559,7 @@ def precompute(psd, theories=("average", "critical_junction", "emt"), gamma=1.0,
     a_perc : float       critical-junction percolation threshold A(ζc)/A0 (0.5; 0.42 option)
     alpha_cj : float     critical-junction factor on u1(ζc)
     grid : Grid or (log10_min, log10_max, n), optional   base p̄ grid (default: default_grid)
-    emt_n_area : int     Gauss–Legendre nodes of the effective-medium integral
+    emt_tol : float      relative accuracy of the adaptive effective-medium integral
     emt_almqvist : bool  Almqvist-broadened separation distribution in the effective medium
     points_per_decade : int, optional  density of the default base grid
     tolerance : dict, optional  overrides of TOLERANCE ("u", "p_of_u", "sigma")
@@ -565,7 +567,7 @@ def precompute(psd, theories=("average", "critical_junction", "emt"), gamma=1.0,
     """
     t_start = time.perf_counter()
     _check_psd(psd)
-    theories, options = _theory_options(theories, gamma, a_perc, alpha_cj, emt_n_area, emt_almqvist)
+    theories, options = _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist)
     gamma = options["gamma"]
     if grid is None:
         grid = default_grid(psd, gamma, points_per_decade or DEFAULT_POINTS_PER_DECADE)
@@ -577,7 +579,7 @@ def precompute(psd, theories=("average", "critical_junction", "emt"), gamma=1.0,
     tol = dict(TOLERANCE)
     tol.update(tolerance or {})
     sig_opts = dict(gamma=gamma, a_perc=options["a_perc"], alpha_cj=options["alpha_cj"],
-                    n_area=options["emt_n_area"], almqvist=options["emt_almqvist"])
+                    tol=options["emt_tol"], almqvist=options["emt_almqvist"])
     h = psd.h_rms
     lnp = grid.ln_nodes()
     cols = _exact(psd, np.exp(lnp), theories, sig_opts)

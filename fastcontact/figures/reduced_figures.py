@@ -10,6 +10,9 @@
 
 ū(0) is the module default of :mod:`fastcontact.reduced`, p_cont(0) = 1e-3 p0.
 
+Rendering uses the Agg canvas directly (no pyplot, no global backend change); each PNG is
+written to a temporary name in ``outdir`` and renamed into place (atomic).
+
 Run as a script: ``python -m fastcontact.figures.reduced_figures [outdir]``.
 """
 from __future__ import annotations
@@ -19,14 +22,12 @@ import sys
 import tempfile
 from pathlib import Path
 
-import matplotlib
+import matplotlib.ticker
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from fastcontact.reduced import (flat_separation_reduced, squeeze_out_reduced,  # noqa: E402
-                                 u_of_t_reduced)
+from fastcontact.reduced import flat_separation_reduced, squeeze_out_reduced, u_of_t_reduced
 
 __all__ = ["make_reduced_figures"]
 
@@ -42,26 +43,35 @@ def _save_atomic(fig, path: Path) -> Path:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png.tmp", dir=path.parent)
     os.close(fd)
     try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)          # mkstemp creates 0600
         fig.savefig(tmp, format="png", dpi=150)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
-    finally:
-        plt.close(fig)
     return path
 
 
+def _new_figure(**kw):
+    """A pyplot-free Figure on the Agg canvas (no global backend switch, no figure manager)."""
+    fig = Figure(layout="constrained", **kw)
+    FigureCanvasAgg(fig)
+    return fig
+
+
 def _figure_u_of_t(path: Path) -> Path:
-    fig, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
+    fig = _new_figure(figsize=(6.4, 4.8))
+    ax = fig.subplots()
     cases = squeeze_out_reduced(np.asarray(KAPPAS_FIG2), ALPHA, ratio=RATIO)
     t = np.logspace(-6, 1, 600)
     for row in cases.itertuples():
         u_rough = u_of_t_reduced(row.kappa, row.alpha, t, u_start=row.u_start)
         u_flat = flat_separation_reduced(row.u_start, t, row.alpha)
-        ax.plot(t, u_rough, color="tab:red", lw=1.6)
-        ax.plot(t, u_flat, color="tab:blue", lw=1.2)
+        ax.plot(t, u_flat, color="tab:blue", lw=1.2, zorder=2)
+        ax.plot(t, u_rough, color="tab:red", lw=1.6, zorder=3)
         ax.axhline(row.u_inf, color="tab:red", lw=0.6, ls=":")
         ax.plot(row.t_star, row.u_star, "o", mfc="none", mec="k", ms=5)
         ax.annotate(rf"$\kappa = 10^{{{np.log10(row.kappa):.0f}}}$",
@@ -71,6 +81,9 @@ def _figure_u_of_t(path: Path) -> Path:
     ax.set_yscale("log")
     ax.set_xlim(t[0], t[-1])
     ax.set_ylim(1.0, 50.0)
+    ax.yaxis.set_major_locator(matplotlib.ticker.FixedLocator([1, 2, 5, 10, 20, 50]))
+    ax.yaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+    ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_xlabel(r"time $t$ (units of $\tau = 3\eta R^2/(2\alpha h_{\rm rms}^2 p_0)$)")
     ax.set_ylabel(r"separation $\bar u$ (units of $h_{\rm rms}$)")
     ax.plot([], [], color="tab:red", label="rough (eqs. 8, 10)")
@@ -87,7 +100,8 @@ def _figure_u_of_t(path: Path) -> Path:
 def _figure_tstar(path: Path) -> Path:
     log_kappa = np.linspace(-8.0, -0.05, 300)
     res = squeeze_out_reduced(10.0**log_kappa, ALPHA, ratio=RATIO)
-    fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.4), layout="constrained")
+    fig = _new_figure(figsize=(6.4, 6.4))
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
     ax1.plot(log_kappa, res.t_star, color="tab:red", lw=1.6)
     ax1.set_yscale("log")
     ax1.set_ylabel(r"squeeze-out time $t^*$ (units of $\tau$)")
