@@ -61,7 +61,7 @@ import numpy as np
 import pandas as pd
 from numba import njit
 
-from ._validate import as_float_array, check_positive, check_range
+from ._validate import check_positive, check_range
 
 __all__ = [
     "time_unit_tau",

@@ -106,7 +106,7 @@ def k_table():
 
 
 #: K(0) (SPEC §2), for tests and documentation
-K_ZERO = 0.4071249346
+K_ZERO = 0.40712493463438924
 
 
 @njit(cache=True)

@@ -382,6 +382,9 @@ class Tables:
         os.close(fd)
         try:
             pq.write_table(table, tmp, write_page_checksum=True)
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)
             os.replace(tmp, path)
         except BaseException:
             if os.path.exists(tmp):

@@ -35,7 +35,7 @@ def t_between_mp(kappa, alpha, u_lo, u_hi, dps=40, grow=2):
 
         d = lo - u_inf
         pts = [lo]
-        while pts[-1] + d < hi and d < 1e8:
+        while pts[-1] + d < hi and d < 1e3 * (1 + lo):
             pts.append(pts[-1] + d)
             d *= grow
         pts.append(hi)

@@ -1,0 +1,949 @@
+"""Scenes: a complete study (surfaces, material, fluid, geometry, parameter grid, outputs)
+described in a TOML file, validated up front and run end to end (``fastcontact run``).
+
+A scene is plain data: it is parsed with :mod:`tomllib` and nothing in it is evaluated.
+
+Schema
+------
+Top level: ``title``, ``description`` (strings) and the tables below. Every numeric value is
+either an SI number or a string with a unit from a small explicit table (``"0.2 MPa"``,
+``"2 cm"``, ``"1 mPa s"``, ``"30 m/s"``, ``"1000 kg/m^3"``; see :data:`UNIT_EXAMPLES`). A value of the
+wrong dimension is an error naming the key.
+
+``[study]``
+    ``kind`` = ``"squeeze"`` | ``"tire"`` | ``"seal"`` (required); ``theory`` (any of
+    ``"average"``, ``"critical_junction"``, ``"emt"``; default ``"average"`` for squeeze and tire,
+    ``"critical_junction"`` for seal); ``p0`` nominal (applied) pressure.
+    squeeze: ``u_start`` (initial ū, optional), ``ratios`` (ū/ū∞ for t_ratio columns),
+    ``du`` (Δu values for t_du columns), ``times`` (times for u_at columns).
+    tire: ``footprint_length``, ``speed``, ``pressure_profile`` (``"uniform"``,
+    ``"parabolic"`` or a list of relative values at equally spaced stations),
+    ``pressure_model`` (``"mean"`` | ``"peak"``), ``du_complete`` (default 1 µm), ``ratios``,
+    ``u_start`` (default: 1 cm, the paper's u(0)).
+    seal: ``dp`` (pressure difference p_a - p_b), ``p_b``, ``profile`` (``"uniform"`` |
+    ``"hertz"``), ``f_N`` (load per unit length, Hertz profile).
+``[surfaces.<name>]``
+    exactly one of ``table = "file.parquet"`` (a table file: relative to the scene file, else
+    one of the embedded default tables, see :func:`default_table_path`), ``psd = "file.csv"``
+    with ``convention`` (``"persson"`` | ``"surface_topography"``), or self-affine parameters
+    ``h_rms``, ``hurst``, ``q0``, ``q1`` [, ``q_roll``]; optional ``label``.
+``[material]``
+    ``E_star``, or ``E`` and ``nu`` (optionally a second solid ``E2``, ``nu2``).
+``[fluid]``
+    ``eta`` (required), ``rho`` (tire: default 1000 kg/m³), ``name``.
+``[geometry]``
+    ``R`` (block radius; squeeze, tire; O-ring radius for a Hertz seal), ``L`` (seal width),
+    ``L_y`` (seal length).
+``[tables]``
+    ``gamma``, ``a_perc``, ``alpha_cj`` (options of :func:`fastcontact.tables.precompute`),
+    ``cache_dir``.
+``[outputs]``
+    ``columns`` (result columns wanted, ``*`` patterns allowed; default all),
+    ``figures`` (figure names wanted; default none).
+``[sweep]``
+    ``combine`` = ``"product"`` (default: every combination of the axes) | ``"zip"``.
+
+Sweep axes: every parameter marked *axis* in :data:`AXIS_KEYS` may be a scalar, a list
+(``p0 = ["0.1 MPa", "0.2 MPa"]``) or a range table ``{start, stop, num, log = true}``;
+``theory`` may be a list. The cases are the product (or zip) of all axes, evaluated on every
+surface.
+
+Running (:func:`run_scene`) tabulates only the theories the study asks for, reuses tables from a
+cache keyed by the surface fingerprint and the table options (atomic writes), computes only
+the requested columns and figures, and writes ``results.parquet`` (scene and provenance in the
+key-value metadata under ``fastcontact``), ``summary.txt``, ``build_record.json`` and
+``figures/*.png``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import datetime as _dt
+import difflib
+import fnmatch
+import hashlib
+import itertools
+import json
+import math
+import os
+import re
+import sys
+import tempfile
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+__all__ = [
+    "SceneError", "Scene", "SurfaceSpec", "load_scene", "parse_quantity", "default_table_path",
+    "example_scene_path", "list_example_scenes", "table_cache_dir", "obtain_tables",
+    "run_scene", "evaluate_cases", "available_columns", "available_figures", "STUDY_KINDS",
+    "PAPER_REFERENCE",
+]
+
+STUDY_KINDS = ("squeeze", "tire", "seal")
+PAPER_REFERENCE = ("B. Lorenz and B.N.J. Persson, Fluid squeeze-out between solids with rough "
+                   "surfaces, Eur. Phys. J. E 32, 281 (2010)")
+THEORY_NAMES = ("average", "critical_junction", "emt")
+CONVENTION_NAMES = ("persson", "surface_topography")
+
+
+class SceneError(ValueError):
+    """An invalid scene: ``problems`` lists every problem found (each names its key)."""
+
+    def __init__(self, source, problems):
+        self.source = str(source)
+        self.problems = list(problems)
+        n = len(self.problems)
+        head = f"scene {self.source} is invalid ({n} problem{'s' if n != 1 else ''})"
+        super().__init__(head + ": " + "; ".join(self.problems))
+
+
+# =========================================================================== units
+# dimension vectors over (kg, m, s)
+DIMENSIONS = {
+    "pressure": (1, -1, -2), "length": (0, 1, 0), "wavevector": (0, -1, 0),
+    "viscosity": (1, -1, -1), "density": (1, -3, 0), "time": (0, 0, 1),
+    "velocity": (0, 1, -1), "force_per_length": (1, 0, -2), "dimensionless": (0, 0, 0),
+}
+UNIT_EXAMPLES = {
+    "pressure": "Pa, kPa, MPa, GPa, bar, psi", "length": "m, cm, mm, um, nm",
+    "wavevector": "1/m, 1/mm, 1/um", "viscosity": "Pa s, mPa s, cP",
+    "density": "kg/m^3, g/cm^3", "time": "s, ms, us, min", "velocity": "m/s, km/h",
+    "force_per_length": "N/m, N/mm", "dimensionless": "no unit",
+}
+_BASE_UNITS = {
+    "m": (1.0, (0, 1, 0)), "s": (1.0, (0, 0, 1)), "g": (1e-3, (1, 0, 0)),
+    "Pa": (1.0, (1, -1, -2)), "N": (1.0, (1, 1, -2)), "bar": (1e5, (1, -1, -2)),
+    "P": (0.1, (1, -1, -1)),            # poise (cP = 1 mPa s)
+}
+_EXACT_UNITS = {
+    "min": (60.0, (0, 0, 1)), "h": (3600.0, (0, 0, 1)),
+    "psi": (6894.757293168361, (1, -1, -2)), "1": (1.0, (0, 0, 0)),
+}
+_PREFIXES = {"n": 1e-9, "u": 1e-6, "µ": 1e-6, "μ": 1e-6, "m": 1e-3, "c": 1e-2, "k": 1e3,
+             "M": 1e6, "G": 1e9}
+_NUMBER = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*(.*?)\s*$")
+_TOKEN = re.compile(r"^([A-Za-zµμ]+|1)(?:\^?([+-]?\d+)|([²³]))?$")
+
+
+class UnitError(ValueError):
+    pass
+
+
+def _unit_token(tok):
+    m = _TOKEN.match(tok)
+    if not m:
+        raise UnitError(f"cannot read unit {tok!r}")
+    sym, exp, sup = m.group(1), m.group(2), m.group(3)
+    power = int(exp) if exp else ({"²": 2, "³": 3}[sup] if sup else 1)
+    if sym in _EXACT_UNITS:
+        f, d = _EXACT_UNITS[sym]
+    elif sym in _BASE_UNITS:
+        f, d = _BASE_UNITS[sym]
+    elif len(sym) > 1 and sym[0] in _PREFIXES and sym[1:] in _BASE_UNITS:
+        f0, d = _BASE_UNITS[sym[1:]]
+        f = _PREFIXES[sym[0]] * f0
+    else:
+        raise UnitError(f"unknown unit {sym!r}")
+    return f ** power, tuple(power * x for x in d)
+
+
+def parse_unit(text):
+    """(factor to SI, dimension vector) of a unit string such as ``"mPa s"`` or ``"kg/m^3"``."""
+    text = text.replace("·", " ").replace("⋅", " ").replace("*", " ").strip()
+    if text.count("/") > 1:
+        raise UnitError(f"unit {text!r} has more than one '/'")
+    num, _, den = text.partition("/")
+    factor, dims = 1.0, (0, 0, 0)
+    for part, sign in ((num, 1), (den, -1)):
+        toks = part.split()
+        if sign == -1 and not toks:
+            raise UnitError(f"unit {text!r} has nothing after '/'")
+        for tok in toks:
+            f, d = _unit_token(tok)
+            factor *= f ** sign
+            dims = tuple(a + sign * b for a, b in zip(dims, d))
+    if num.strip() == "" and den:
+        raise UnitError(f"unit {text!r} has nothing before '/' (write 1/{den.strip()})")
+    return factor, dims
+
+
+# km/h is common for speeds: 'h' is an exact unit, 'km' prefixed metre
+def parse_quantity(key, value, dim):
+    """SI float of ``value`` (number, or string with a unit of dimension ``dim``).
+
+    Raises ValueError naming ``key`` for non-numbers, unknown units and wrong dimensions.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise ValueError(f"{key} = {value!r}: must be a number"
+                         + ("" if dim == "dimensionless" else
+                            f" in SI units or a string with a unit ({UNIT_EXAMPLES[dim]})"))
+    if isinstance(value, str):
+        m = _NUMBER.match(value)
+        if not m:
+            raise ValueError(f"{key} = {value!r}: not a number with a unit "
+                             f"(e.g. {_example(dim)!r})")
+        x, unit = float(m.group(1)), m.group(2)
+        if unit:
+            try:
+                factor, dims = parse_unit(unit)
+            except UnitError as exc:
+                raise ValueError(f"{key} = {value!r}: {exc} (a {dim.replace('_', ' ')} "
+                                 f"takes {UNIT_EXAMPLES[dim]})") from None
+            if dims != DIMENSIONS[dim]:
+                raise ValueError(f"{key} = {value!r}: wrong unit {unit!r}, {key} is a "
+                                 f"{dim.replace('_', ' ')} ({UNIT_EXAMPLES[dim]})")
+            x *= factor
+    else:
+        x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{key} = {value!r}: must be finite")
+    return x
+
+
+def _example(dim):
+    return {"pressure": "0.2 MPa", "length": "2 cm", "wavevector": "1e5 1/m",
+            "viscosity": "1 mPa s", "density": "1000 kg/m^3", "time": "3 ms",
+            "velocity": "30 m/s", "force_per_length": "1 N/mm", "dimensionless": "0.5"}[dim]
+
+
+# =========================================================================== schema
+@dataclasses.dataclass(frozen=True)
+class _Key:
+    kind: str                      # "num", "str", "choice", "list_num", "profile", "theory", "bool"
+    dim: str = "dimensionless"
+    axis: bool = False
+    studies: tuple = STUDY_KINDS   # study kinds that use the key
+    lo: float | None = None        # bounds (inclusive unless *_open)
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+    choices: tuple = ()
+    doc: str = ""
+
+
+_ALL = STUDY_KINDS
+SCHEMA = {
+    "study": {
+        "kind": _Key("choice", choices=STUDY_KINDS, doc="study kind"),
+        "theory": _Key("theory", axis=True, doc="flow-conductivity theory"),
+        "p0": _Key("num", "pressure", axis=True, lo=0, lo_open=True, doc="nominal pressure"),
+        "u_start": _Key("num", "length", axis=True, studies=("squeeze", "tire"), lo=0,
+                        lo_open=True, doc="initial mean separation"),
+        "ratios": _Key("list_num", studies=("squeeze", "tire"), lo=1, lo_open=True,
+                       doc="ū/ū∞ targets"),
+        "du": _Key("list_num", "length", studies=("squeeze",), lo=0, lo_open=True,
+                   doc="Δu targets"),
+        "times": _Key("list_num", "time", studies=("squeeze",), lo=0, lo_open=True,
+                      doc="times for ū(t)"),
+        "footprint_length": _Key("num", "length", axis=True, studies=("tire",), lo=0,
+                                 lo_open=True),
+        "speed": _Key("num", "velocity", axis=True, studies=("tire",), lo=0, lo_open=True),
+        "pressure_profile": _Key("profile", studies=("tire",)),
+        "pressure_model": _Key("choice", studies=("tire",), choices=("mean", "peak")),
+        "du_complete": _Key("num", "length", studies=("tire",), lo=0, lo_open=True),
+        "dp": _Key("num", "pressure", axis=True, studies=("seal",), lo=0),
+        "p_b": _Key("num", "pressure", axis=True, studies=("seal",), lo=0),
+        "profile": _Key("choice", studies=("seal",), choices=("uniform", "hertz")),
+        "f_N": _Key("num", "force_per_length", axis=True, studies=("seal",), lo=0, lo_open=True),
+    },
+    "material": {
+        "E": _Key("num", "pressure", axis=True, lo=0, lo_open=True),
+        "nu": _Key("num", axis=True, lo=0, hi=0.5),
+        "E_star": _Key("num", "pressure", axis=True, lo=0, lo_open=True),
+        "E2": _Key("num", "pressure", axis=True, lo=0, lo_open=True),
+        "nu2": _Key("num", axis=True, lo=0, hi=0.5),
+        "name": _Key("str"),
+    },
+    "fluid": {
+        "eta": _Key("num", "viscosity", axis=True, lo=0, lo_open=True),
+        "rho": _Key("num", "density", axis=True, lo=0, lo_open=True),
+        "name": _Key("str"),
+    },
+    "geometry": {
+        "R": _Key("num", "length", axis=True, lo=0, lo_open=True),
+        "L": _Key("num", "length", axis=True, studies=("seal",), lo=0, lo_open=True),
+        "L_y": _Key("num", "length", axis=True, studies=("seal",), lo=0, lo_open=True),
+    },
+    "tables": {
+        "gamma": _Key("num", lo=0, hi=1, lo_open=True),
+        "a_perc": _Key("num", lo=0, hi=1, lo_open=True, hi_open=True),
+        "alpha_cj": _Key("num", lo=0, lo_open=True),
+        "cache_dir": _Key("str"),
+    },
+    "outputs": {
+        "columns": _Key("strlist"),
+        "figures": _Key("strlist"),
+    },
+    "sweep": {
+        "combine": _Key("choice", choices=("product", "zip")),
+    },
+}
+SURFACE_KEYS = {
+    "table": _Key("str"), "psd": _Key("str"), "convention": _Key("choice", choices=CONVENTION_NAMES),
+    "h_rms": _Key("num", "length", lo=0, lo_open=True),
+    "hurst": _Key("num", lo=0, hi=1, lo_open=True, hi_open=True),
+    "q0": _Key("num", "wavevector", lo=0, lo_open=True),
+    "q1": _Key("num", "wavevector", lo=0, lo_open=True),
+    "q_roll": _Key("num", "wavevector", lo=0, lo_open=True),
+    "label": _Key("str"),
+}
+TOP_KEYS = ("title", "description", "study", "surfaces", *[s for s in SCHEMA if s != "study"])
+#: every axis parameter (case column name → section)
+AXIS_KEYS = {k: sec for sec, keys in SCHEMA.items() for k, spec in keys.items() if spec.axis}
+RANGE_KEYS = ("start", "stop", "num", "log")
+
+FIGURES = {
+    "squeeze": ("u_of_t", "t_star"),
+    "tire": ("u_of_t", "du_of_t"),
+    "seal": ("leak_rate", "profiles"),
+}
+DEFAULTS = {
+    "squeeze": {"theory": "average", "ratios": (1.1, 1.01, 1.001), "du": (1e-6,), "times": ()},
+    "tire": {"theory": "average", "ratios": (1.1, 1.01, 1.001), "pressure_profile": "uniform",
+             "pressure_model": "mean", "du_complete": 1e-6, "u_start": 1e-2, "rho": 1000.0},
+    "seal": {"theory": "critical_junction", "p_b": 0.0, "profile": "uniform"},
+}
+
+
+def _did_you_mean(word, choices):
+    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.5)
+    if close:
+        return f" (did you mean {close[0]!r}?)"
+    return f" (allowed: {', '.join(map(str, choices))})"
+
+
+def _fmt_num(x):
+    """Short, stable text of a number for column names (1.01 → '1.01', 1e-6 → '1e-06')."""
+    return repr(float(x)) if 1e-3 <= abs(x) < 1e4 else f"{x:.6g}"
+
+
+# =========================================================================== files
+def _package_dir() -> Path:
+    return Path(__file__).resolve().parent
+
+
+def default_table_path(name) -> Path:
+    """Path of an embedded default table (``asphalt_072mm``, ``pmma_34um`` ...).
+
+    Looks in the package data ``fastcontact/data/`` first, then the repository's ``tables/``
+    folder. ``name`` may omit the ``.parquet`` suffix. Raises FileNotFoundError listing the
+    available names.
+    """
+    name = str(name)
+    if not name.endswith(".parquet"):
+        name += ".parquet"
+    if "/" in name or "\\" in name or name.startswith("."):
+        raise FileNotFoundError(f"table {name!r} is not a default table name")
+    dirs = [_package_dir() / "data", _package_dir().parent / "tables"]
+    for d in dirs:
+        p = d / name
+        if p.is_file():
+            return p
+    avail = sorted({p.name for d in dirs if d.is_dir() for p in d.glob("*.parquet")})
+    raise FileNotFoundError(f"table {name!r} is neither a file nor an embedded default table "
+                            f"(available: {', '.join(avail) or 'none'})")
+
+
+def list_example_scenes():
+    """Names of the example scenes shipped in ``fastcontact/scenes``."""
+    return sorted(p.stem for p in (_package_dir() / "scenes").glob("*.toml"))
+
+
+def example_scene_path(name) -> Path:
+    p = _package_dir() / "scenes" / (name if str(name).endswith(".toml") else f"{name}.toml")
+    if not p.is_file():
+        raise FileNotFoundError(f"scene {name!r} is neither a file nor a shipped example scene"
+                                + _did_you_mean(name, list_example_scenes()))
+    return p
+
+
+def table_cache_dir(explicit=None) -> Path:
+    """Table cache: ``explicit``, else $FASTCONTACT_CACHE_DIR, else ~/.cache/fastcontact/tables."""
+    if explicit:
+        return Path(explicit).expanduser()
+    env = os.environ.get("FASTCONTACT_CACHE_DIR")
+    if env:
+        return Path(env).expanduser()
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "fastcontact" / "tables"
+
+
+def _read_table_metadata(path):
+    """The fastcontact metadata of a tables file (schema only; the data are not read)."""
+    import pyarrow.parquet as pq
+    try:
+        schema = pq.read_schema(path)
+    except Exception as exc:  # noqa: BLE001 - pyarrow raises several types
+        raise ValueError(f"cannot read {str(path)!r} as Parquet ({type(exc).__name__})") from None
+    raw = (schema.metadata or {}).get(b"fastcontact")
+    if raw is None:
+        raise ValueError(f"{str(path)!r} is not a fastcontact tables file (no metadata)")
+    try:
+        return json.loads(raw)
+    except ValueError:
+        raise ValueError(f"{str(path)!r} has corrupted fastcontact metadata") from None
+
+
+# =========================================================================== scene
+@dataclasses.dataclass
+class SurfaceSpec:
+    """One surface of a scene: a table file, a PSD file or self-affine parameters."""
+
+    name: str
+    source: str                 # "table" | "psd" | "self_affine" | "inline"
+    path: Path | None = None
+    convention: str | None = None
+    params: dict = dataclasses.field(default_factory=dict)
+    label: str | None = None
+    psd_obj: object = None      # an already-built PSD (sweeps)
+
+    def psd(self):
+        """The surface's PSD (not for ``source == "table"``)."""
+        if self.psd_obj is not None:
+            return self.psd_obj
+        if self.source == "self_affine":
+            from .psd import SelfAffinePSD
+            self.psd_obj = SelfAffinePSD(self.params["h_rms"], self.params["hurst"],
+                                         self.params["q0"], self.params["q1"],
+                                         self.params.get("q_roll"))
+        elif self.source == "psd":
+            from .topography import read_psd
+            self.psd_obj = read_psd(self.path, self.convention)
+        else:
+            raise ValueError(f"surface {self.name!r} is given as a table file")
+        return self.psd_obj
+
+    def describe(self):
+        if self.source == "table":
+            return {"table": str(self.path)}
+        if self.source == "psd":
+            return {"psd": str(self.path), "convention": self.convention}
+        if self.source == "self_affine":
+            return {"self_affine": dict(self.params)}
+        return {"inline": self.psd().to_dict()}
+
+
+@dataclasses.dataclass
+class Scene:
+    """A validated scene (see the module docstring). Build with :func:`load_scene`."""
+
+    source: str
+    base_dir: Path
+    text: str
+    data: dict
+    title: str
+    kind: str
+    surfaces: dict
+    axes: dict           # axis name → list of values (SI floats; theory: strings)
+    fixed: dict          # non-axis study parameters (ratios, du, times, profile ...)
+    table_options: dict  # gamma, a_perc, alpha_cj (as given; defaults filled)
+    table_options_given: dict
+    cache_dir: str | None
+    columns: list
+    figures: list
+    combine: str
+
+    @property
+    def theories(self):
+        """The theories the study needs, in canonical order."""
+        ths = set(self.axes["theory"])
+        return tuple(t for t in THEORY_NAMES if t in ths)
+
+    @property
+    def sha256(self):
+        return hashlib.sha256(self.text.encode()).hexdigest()
+
+    def cases(self):
+        """DataFrame of the cases (one row each, ``case_id`` 0..n-1), SI units; adds E_star."""
+        import pandas as pd
+        names = list(self.axes)
+        if self.combine == "zip":
+            n = max(len(v) for v in self.axes.values())
+            rows = [tuple(self.axes[k][i if len(self.axes[k]) > 1 else 0] for k in names)
+                    for i in range(n)]
+        else:
+            rows = list(itertools.product(*(self.axes[k] for k in names)))
+        df = pd.DataFrame(rows, columns=names)
+        if "E_star" not in self.axes:
+            from .elasticity import effective_modulus
+            kw = {}
+            if "E2" in df:
+                kw = dict(E2=df["E2"].to_numpy(float), nu2=df["nu2"].to_numpy(float))
+            df["E_star"] = np.asarray(effective_modulus(df["E"].to_numpy(float),
+                                                        df["nu"].to_numpy(float), **kw), float)
+        df.insert(0, "case_id", np.arange(len(df), dtype=np.int64))
+        return df
+
+    def normalized(self):
+        """JSON-serialisable resolved scene (SI values), for provenance."""
+        return {
+            "title": self.title, "kind": self.kind,
+            "surfaces": {k: s.describe() for k, s in self.surfaces.items()},
+            "axes": self.axes, "fixed": {k: (list(v) if isinstance(v, tuple) else v)
+                                         for k, v in self.fixed.items()},
+            "table_options": self.table_options, "columns": self.columns,
+            "figures": self.figures, "combine": self.combine,
+        }
+
+
+def _check_bounds(key, x, spec):
+    lo_ok = spec.lo is None or (x > spec.lo if spec.lo_open else x >= spec.lo)
+    hi_ok = spec.hi is None or (x < spec.hi if spec.hi_open else x <= spec.hi)
+    if not (lo_ok and hi_ok):
+        parts = []
+        if spec.lo is not None:
+            parts.append(f"{'>' if spec.lo_open else '>='} {spec.lo:g}")
+        if spec.hi is not None:
+            parts.append(f"{'<' if spec.hi_open else '<='} {spec.hi:g}")
+        raise ValueError(f"{key} = {x!r}: must be {' and '.join(parts)}"
+                         + ("" if spec.dim == "dimensionless" else " [SI]"))
+
+
+def _parse_scalar(key, value, spec):
+    x = parse_quantity(key, value, spec.dim)
+    _check_bounds(key, x, spec)
+    return x
+
+
+def _parse_axis(key, value, spec, problems):
+    """List of SI floats for an axis value (scalar, list or range table)."""
+    if isinstance(value, dict):
+        unknown = [k for k in value if k not in RANGE_KEYS]
+        for k in unknown:
+            problems.append(f"{key}.{k}: unknown key in a range table" + _did_you_mean(k, RANGE_KEYS))
+        missing = [k for k in ("start", "stop", "num") if k not in value]
+        for k in missing:
+            problems.append(f"{key}: range table needs '{k}' (keys: start, stop, num, log)")
+        if unknown or missing:
+            return None
+        ok = True
+        try:
+            a = _parse_scalar(f"{key}.start", value["start"], spec)
+        except ValueError as exc:
+            problems.append(str(exc)); ok = False
+        try:
+            b = _parse_scalar(f"{key}.stop", value["stop"], spec)
+        except ValueError as exc:
+            problems.append(str(exc)); ok = False
+        num, log = value["num"], value.get("log", False)
+        if isinstance(num, bool) or not isinstance(num, int) or num < 1:
+            problems.append(f"{key}.num = {num!r}: must be an integer >= 1"); ok = False
+        if not isinstance(log, bool):
+            problems.append(f"{key}.log = {log!r}: must be true or false"); ok = False
+        if not ok:
+            return None
+        if log:
+            if a <= 0 or b <= 0:
+                problems.append(f"{key}: a log range needs start and stop > 0")
+                return None
+            return [float(x) for x in np.geomspace(a, b, num)]
+        return [float(x) for x in np.linspace(a, b, num)]
+    if isinstance(value, list):
+        if not value:
+            problems.append(f"{key} = []: an axis needs at least one value")
+            return None
+        out = []
+        for i, v in enumerate(value):
+            try:
+                out.append(_parse_scalar(f"{key}[{i}]", v, spec))
+            except ValueError as exc:
+                problems.append(str(exc))
+        return out if len(out) == len(value) else None
+    try:
+        return [_parse_scalar(key, value, spec)]
+    except ValueError as exc:
+        problems.append(str(exc))
+        return None
+
+
+def _parse_list_num(key, value, spec, problems):
+    vals = value if isinstance(value, list) else [value]
+    out = []
+    for i, v in enumerate(vals):
+        try:
+            out.append(_parse_scalar(f"{key}[{i}]" if isinstance(value, list) else key, v, spec))
+        except ValueError as exc:
+            problems.append(str(exc))
+    return tuple(out) if len(out) == len(vals) else None
+
+
+def _parse_strlist(key, value, problems):
+    vals = value if isinstance(value, list) else [value]
+    if not all(isinstance(v, str) for v in vals):
+        problems.append(f"{key} = {value!r}: must be a list of strings")
+        return None
+    return list(vals)
+
+
+def _table_needed(kind, columns, figures):
+    return True
+
+
+def load_scene(scene, *, for_sweep=False, base_dir=None):
+    """Parse and validate a scene; return a :class:`Scene` or raise :class:`SceneError`.
+
+    ``scene`` is a path to a TOML file, the name of a shipped example scene, or a dict (the
+    parsed TOML). Every problem is collected (unknown keys with did-you-mean, wrong types,
+    units and ranges, missing or unusable files) and reported together. With ``for_sweep``
+    the surfaces come from a road database, so ``[surfaces]`` is optional.
+    """
+    problems = []
+    if isinstance(scene, dict):
+        data, text, source = scene, json.dumps(scene, sort_keys=True, default=str), "<dict>"
+        base = Path(base_dir or ".").resolve()
+    else:
+        path = Path(scene)
+        if not path.is_file():
+            try:
+                path = example_scene_path(scene)
+            except FileNotFoundError as exc:
+                raise SceneError(scene, [f"scene file {str(scene)!r} does not exist"
+                                         + (str(exc)[str(exc).find(" (did"):]
+                                            if "(did" in str(exc) else "")]) from None
+        source = str(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise SceneError(source, [f"cannot read scene file: {exc}"]) from None
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise SceneError(source, [f"not valid TOML: {exc}"]) from None
+        base = Path(base_dir).resolve() if base_dir else path.resolve().parent
+
+    for k in data:
+        if k not in TOP_KEYS:
+            problems.append(f"{k}: unknown top-level key" + _did_you_mean(k, TOP_KEYS))
+    for k in ("title", "description"):
+        if k in data and not isinstance(data[k], str):
+            problems.append(f"{k} = {data[k]!r}: must be a string")
+    sections = {}
+    for sec in ("study", "material", "fluid", "geometry", "tables", "outputs", "sweep", "surfaces"):
+        v = data.get(sec, {})
+        if not isinstance(v, dict):
+            problems.append(f"[{sec}] must be a table (section), got {type(v).__name__}")
+            v = {}
+        sections[sec] = v
+
+    study = sections["study"]
+    kind = study.get("kind")
+    if kind is None:
+        problems.append(f"study.kind is missing: one of {', '.join(STUDY_KINDS)}")
+    elif kind not in STUDY_KINDS:
+        problems.append(f"study.kind = {kind!r}: unknown study kind" + _did_you_mean(kind, STUDY_KINDS))
+        kind = None
+    defaults = DEFAULTS.get(kind, {})
+
+    axes, fixed, given = {}, {}, {}
+    for sec, keys in SCHEMA.items():
+        secd = sections[sec]
+        for k, v in secd.items():
+            key = f"{sec}.{k}"
+            spec = keys.get(k)
+            if spec is None:
+                problems.append(f"{key}: unknown key" + _did_you_mean(k, list(keys)))
+                continue
+            if kind is not None and kind not in spec.studies:
+                problems.append(f"{key}: not used by a {kind!r} study (used by: "
+                                f"{', '.join(spec.studies)})")
+                continue
+            given[(sec, k)] = v
+            if spec.kind == "num":
+                if spec.axis:
+                    vals = _parse_axis(key, v, spec, problems)
+                    if vals is not None:
+                        axes[k] = vals
+                else:
+                    try:
+                        fixed[k] = _parse_scalar(key, v, spec)
+                    except ValueError as exc:
+                        problems.append(str(exc))
+            elif spec.kind == "theory":
+                vals = v if isinstance(v, list) else [v]
+                ok = True
+                for t in vals:
+                    if not isinstance(t, str) or t not in THEORY_NAMES:
+                        problems.append(f"{key} = {t!r}: unknown theory" + _did_you_mean(t, THEORY_NAMES))
+                        ok = False
+                if not vals:
+                    problems.append(f"{key} = []: name at least one theory"); ok = False
+                if ok:
+                    axes[k] = list(dict.fromkeys(vals))
+            elif spec.kind == "choice":
+                if not isinstance(v, str) or v not in spec.choices:
+                    if k != "kind":
+                        problems.append(f"{key} = {v!r}: must be one of {', '.join(spec.choices)}"
+                                        + (_did_you_mean(v, spec.choices) if isinstance(v, str) else ""))
+                elif k != "kind":
+                    fixed[k] = v
+            elif spec.kind == "str":
+                if not isinstance(v, str):
+                    problems.append(f"{key} = {v!r}: must be a string")
+                else:
+                    fixed[k] = v
+            elif spec.kind == "list_num":
+                vals = _parse_list_num(key, v, spec, problems)
+                if vals is not None:
+                    fixed[k] = vals
+            elif spec.kind == "strlist":
+                vals = _parse_strlist(key, v, problems)
+                if vals is not None:
+                    fixed[f"{sec}.{k}"] = vals
+            elif spec.kind == "profile":
+                if isinstance(v, str):
+                    if v not in ("uniform", "parabolic"):
+                        problems.append(f"{key} = {v!r}: must be 'uniform', 'parabolic' or a list of "
+                                        f"relative pressures" + _did_you_mean(v, ("uniform", "parabolic")))
+                    else:
+                        fixed[k] = v
+                elif isinstance(v, list) and len(v) >= 2:
+                    vals = _parse_list_num(key, v, _Key("num", lo=0), problems)
+                    if vals is not None:
+                        if sum(vals) <= 0:
+                            problems.append(f"{key}: the relative pressures must not all be 0")
+                        else:
+                            fixed[k] = tuple(vals)
+                else:
+                    problems.append(f"{key} = {v!r}: must be 'uniform', 'parabolic' or a list of "
+                                    f">= 2 relative pressures along the footprint")
+
+    # ------------------------------------------------------------ required / defaults
+    if kind is not None:
+        if "p0" not in axes and ("study", "p0") not in given:
+            problems.append("study.p0 is missing: the nominal pressure, e.g. p0 = \"0.2 MPa\"")
+        if "theory" not in axes and ("study", "theory") not in given:
+            axes["theory"] = [defaults["theory"]]
+        for k in ("ratios", "du", "times", "pressure_profile", "pressure_model", "du_complete",
+                  "profile"):
+            if k in defaults and k not in fixed and ("study", k) not in given:
+                fixed[k] = defaults[k]
+        if kind in ("squeeze", "tire") and "R" not in axes and ("geometry", "R") not in given:
+            problems.append("geometry.R is missing: the block radius, e.g. R = \"2 cm\"")
+        if kind == "tire":
+            for k in ("footprint_length", "speed"):
+                if k not in axes and ("study", k) not in given:
+                    problems.append(f"study.{k} is missing (tire study)")
+            if "u_start" not in axes and ("study", "u_start") not in given:
+                axes["u_start"] = [defaults["u_start"]]
+            if "rho" not in axes and ("fluid", "rho") not in given:
+                axes["rho"] = [defaults["rho"]]
+        if kind == "seal":
+            for k in ("dp",):
+                if k not in axes and ("study", k) not in given:
+                    problems.append(f"study.{k} is missing (seal study): the pressure difference")
+            for k in ("L", "L_y"):
+                if k not in axes and ("geometry", k) not in given:
+                    problems.append(f"geometry.{k} is missing (seal study)")
+            if "p_b" not in axes and ("study", "p_b") not in given:
+                axes["p_b"] = [defaults["p_b"]]
+            if fixed.get("profile") == "hertz":
+                for k, sec in (("R", "geometry"), ("f_N", "study")):
+                    if k not in axes and (sec, k) not in given:
+                        problems.append(f"{sec}.{k} is missing: profile = 'hertz' needs the O-ring "
+                                        f"radius R and the load per unit length f_N")
+            elif ("study", "f_N") in given:
+                problems.append("study.f_N: only used with profile = 'hertz'")
+    if ("fluid", "eta") not in given:
+        problems.append("fluid.eta is missing: the viscosity, e.g. eta = \"1 mPa s\"")
+    mat_given = {k for (s, k) in given if s == "material"}
+    if "E_star" in mat_given:
+        for k in ("E", "nu", "E2", "nu2"):
+            if k in mat_given:
+                problems.append(f"material.{k}: give either E_star or E and nu, not both")
+    else:
+        for k in ("E", "nu"):
+            if k not in mat_given:
+                problems.append(f"material.{k} is missing: give E and nu (E* = E/(1-nu^2)) or E_star")
+        if ("E2" in mat_given) != ("nu2" in mat_given):
+            problems.append("material.E2/nu2: give both the second solid's E2 and nu2, or neither")
+
+    # ------------------------------------------------------------ table options
+    topts = {"gamma": 1.0, "a_perc": 0.5, "alpha_cj": 1.0}
+    topts_given = {k: fixed.pop(k) for k in ("gamma", "a_perc", "alpha_cj") if k in fixed}
+    topts.update(topts_given)
+    cache_dir = fixed.pop("cache_dir", None)
+    if cache_dir is not None:
+        cache_dir = str((base / Path(cache_dir).expanduser()))
+    for k in ("name",):
+        fixed.pop(k, None)
+
+    # ------------------------------------------------------------ surfaces
+    theories = tuple(t for t in THEORY_NAMES if t in axes.get("theory", ()))
+    surfaces = {}
+    sdict = sections["surfaces"]
+    if not sdict and not for_sweep:
+        problems.append("[surfaces] is missing: define at least one [surfaces.<name>]")
+    for name, sd in sdict.items():
+        pre = f"surfaces.{name}"
+        if not isinstance(sd, dict):
+            problems.append(f"{pre} must be a table: [surfaces.{name}] with table/psd/h_rms... keys")
+            continue
+        spec = _parse_surface(pre, name, sd, base, theories, topts_given, problems)
+        if spec is not None:
+            surfaces[name] = spec
+
+    # ------------------------------------------------------------ outputs
+    columns, figures = [], []
+    if kind is not None:
+        avail = available_columns(kind, fixed)
+        want = fixed.pop("outputs.columns", None)
+        if want is None:
+            columns = list(avail)
+        else:
+            for w in want:
+                hit = [c for c in avail if fnmatch.fnmatchcase(c, w)]
+                if not hit:
+                    problems.append(f"outputs.columns: unknown column {w!r} for a {kind!r} study"
+                                    + _did_you_mean(w, avail))
+                columns.extend(c for c in hit if c not in columns)
+        favail = FIGURES[kind]
+        fwant = fixed.pop("outputs.figures", None) or []
+        for f in fwant:
+            if f not in favail:
+                problems.append(f"outputs.figures: unknown figure {f!r} for a {kind!r} study"
+                                + _did_you_mean(f, favail))
+            elif f not in figures:
+                figures.append(f)
+    combine = fixed.pop("combine", "product")
+    if combine == "zip":
+        lens = {k: len(v) for k, v in axes.items() if len(v) > 1}
+        if len(set(lens.values())) > 1:
+            problems.append(f"sweep.combine = 'zip': the list axes have different lengths {lens}")
+
+    if problems:
+        raise SceneError(source, problems)
+    # canonical axis order: schema order
+    order = [k for k in AXIS_KEYS if k in axes]
+    axes = {k: axes[k] for k in order}
+    title = data.get("title") or (Path(source).stem if source != "<dict>" else "scene")
+    return Scene(source=source, base_dir=base, text=text, data=data, title=title, kind=kind,
+                 surfaces=surfaces, axes=axes, fixed=fixed, table_options=topts,
+                 table_options_given=topts_given, cache_dir=cache_dir, columns=columns,
+                 figures=figures, combine=combine)
+
+
+def _resolve_table_file(value, base):
+    p = Path(value).expanduser()
+    cand = p if p.is_absolute() else base / p
+    if cand.is_file():
+        return cand
+    return default_table_path(value)
+
+
+def _parse_surface(pre, name, sd, base, theories, topts_given, problems):
+    n0 = len(problems)
+    for k in sd:
+        if k not in SURFACE_KEYS:
+            problems.append(f"{pre}.{k}: unknown key" + _did_you_mean(k, list(SURFACE_KEYS)))
+    sa_keys = ("h_rms", "hurst", "q0", "q1", "q_roll")
+    has = [s for s in ("table", "psd") if s in sd] + (["h_rms/hurst/q0/q1"] if any(k in sd for k in sa_keys) else [])
+    if len(has) != 1:
+        problems.append(f"{pre}: give exactly one of table = \"file.parquet\", psd = \"file.csv\" "
+                        f"(+ convention) or h_rms, hurst, q0, q1 [, q_roll]"
+                        + (f" (got {', '.join(has)})" if has else ""))
+        return None
+    label = sd.get("label")
+    if label is not None and not isinstance(label, str):
+        problems.append(f"{pre}.label = {label!r}: must be a string")
+    if "table" in sd:
+        v = sd["table"]
+        if "convention" in sd:
+            problems.append(f"{pre}.convention: only used with psd = ...")
+        if not isinstance(v, str):
+            problems.append(f"{pre}.table = {v!r}: must be a file name")
+            return None
+        try:
+            path = _resolve_table_file(v, base)
+        except FileNotFoundError as exc:
+            problems.append(f"{pre}.table = {v!r}: file not found ({str(exc)[str(exc).find('(') + 1:-1]})"
+                            if "(" in str(exc) else f"{pre}.table = {v!r}: file not found")
+            return None
+        try:
+            meta = _read_table_metadata(path)
+        except ValueError as exc:
+            problems.append(f"{pre}.table = {v!r}: {exc}")
+            return None
+        missing = [t for t in theories if t not in meta.get("theories", [])]
+        if missing:
+            problems.append(f"{pre}.table = {v!r}: the table holds theories {meta.get('theories')} "
+                            f"but the study needs {missing} (rebuild it with `fastcontact tables "
+                            f"build --theories ...`, or use a psd/self-affine surface)")
+        for k, val in topts_given.items():
+            have = meta.get("options", {}).get(k)
+            if have is not None and not math.isclose(have, val, rel_tol=1e-12):
+                problems.append(f"{pre}.table = {v!r}: built with {k} = {have!r} but "
+                                f"tables.{k} = {val!r}")
+        if len(problems) > n0:
+            return None
+        return SurfaceSpec(name, "table", path=path, label=label)
+    if "psd" in sd:
+        v, conv = sd["psd"], sd.get("convention")
+        if not isinstance(v, str):
+            problems.append(f"{pre}.psd = {v!r}: must be a file name")
+            return None
+        if conv is None:
+            problems.append(f"{pre}.convention is missing: psd files need convention = 'persson' "
+                            f"or 'surface_topography' (contact.engineering)")
+        elif conv not in CONVENTION_NAMES:
+            problems.append(f"{pre}.convention = {conv!r}: must be one of {', '.join(CONVENTION_NAMES)}"
+                            + _did_you_mean(conv, CONVENTION_NAMES))
+        p = Path(v).expanduser()
+        p = p if p.is_absolute() else base / p
+        if not p.is_file():
+            problems.append(f"{pre}.psd = {v!r}: file not found ({p})")
+        if len(problems) > n0:
+            return None
+        spec = SurfaceSpec(name, "psd", path=p, convention=conv, label=label)
+        try:
+            spec.psd()
+        except ValueError as exc:
+            problems.append(f"{pre}.psd = {v!r}: {exc}")
+            return None
+        return spec
+    params = {}
+    for k in sa_keys:
+        if k in sd:
+            try:
+                params[k] = _parse_scalar(f"{pre}.{k}", sd[k], SURFACE_KEYS[k])
+            except ValueError as exc:
+                problems.append(str(exc))
+        elif k != "q_roll":
+            problems.append(f"{pre}.{k} is missing (self-affine surface: h_rms, hurst, q0, q1)")
+    if "convention" in sd:
+        problems.append(f"{pre}.convention: only used with psd = ...")
+    if len(problems) > n0:
+        return None
+    spec = SurfaceSpec(name, "self_affine", params=params, label=label)
+    try:
+        spec.psd()
+    except ValueError as exc:
+        problems.append(f"{pre}: {exc}")
+        return None
+    return spec
+
+
+# =========================================================================== columns
+def available_columns(kind, fixed):
+    """Result columns a study of ``kind`` can produce with the study parameters ``fixed``."""
+    if kind == "squeeze":
+        from_sq = _squeeze_columns(fixed.get("ratios", DEFAULTS["squeeze"]["ratios"]),
+                                   fixed.get("du", DEFAULTS["squeeze"]["du"]),
+                                   fixed.get("times", DEFAULTS["squeeze"]["times"]))
+        return from_sq
+    if kind == "tire":
+        from .tire import tire_columns
+        return tire_columns(fixed.get("ratios", DEFAULTS["tire"]["ratios"]))
+    if kind == "seal":
+        return list(SEAL_COLUMNS)
+    raise ValueError(f"kind = {kind!r} is invalid")
+
+
+SQUEEZE_BASE_COLUMNS = ("u_start", "u_inf", "t_star", "trapped", "u_trap", "fluid_load_fraction")
+SEAL_COLUMNS = ("Q", "lift_off", "percolated")
+
+
+def _squeeze_columns(ratios, du, times):
+    from .squeeze_names import ratio_col, du_col, time_col  # noqa: F401  (placeholder, see below)
+    raise NotImplementedError

@@ -1,0 +1,267 @@
+"""Issue #3: flow theories, precomputed tables, Parquet round trip and refusal of bad files.
+
+Reference values come from the direct quadrature of the contact core (no tables), evaluated
+at pressures that are NOT grid nodes or refinement midpoints (random log-uniform draws), so
+they test the interpolation honestly.
+"""
+import json
+import math
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+import fastcontact as fc
+from fastcontact import contact
+from fastcontact.conductivity import conductivity, sigma_bar
+from fastcontact.defaults import DEFAULT_SURFACES, default_surface, load_default_tables
+from fastcontact.tables import Tables, TableRangeError, precompute
+
+THEORIES = ("average", "critical_junction", "emt")
+
+
+@pytest.fixture(scope="module")
+def psd():
+    return fc.SelfAffinePSD(h_rms=1e-5, hurst=0.8, q0=1e4, q1=1e8, q_roll=3e4)
+
+
+@pytest.fixture(scope="module")
+def tables(psd):
+    return precompute(psd, theories=THEORIES)
+
+
+def _random_pressures(tables, n, hi_frac=1.0, seed=0):
+    lo, hi = tables.p_range
+    rng = np.random.default_rng(seed)
+    return np.exp(rng.uniform(math.log(lo), math.log(lo) + hi_frac * (math.log(hi) - math.log(lo)), n))
+
+
+def test_mean_separation_and_inverse_match_direct_quadrature(tables, psd):
+    p = _random_pressures(tables, 40)
+    u_exact = contact.mean_separation(psd, p, 1.0)
+    assert np.max(np.abs(tables.mean_separation(p, 1.0) / u_exact - 1)) < 1e-6
+    p_back = tables.contact_pressure(u_exact, 1.0)
+    assert np.max(np.abs(p_back / p - 1)) < 1e-6
+    # E* scaling: one reduced table serves every modulus
+    E = 7.3e6
+    assert np.allclose(tables.mean_separation(p * E, E), u_exact, rtol=1e-6, atol=0)
+
+
+@pytest.mark.parametrize("theory", THEORIES)
+def test_conductivity_matches_direct_quadrature(tables, psd, theory):
+    perc = tables.info["percolation_p_over_E"][theory]
+    p = _random_pressures(tables, 12 if theory == "emt" else 30, seed=1)
+    p = p[p < 0.5 * min(perc, tables.p_range[1])]  # away from percolation
+    eta = 1e-3
+    sig_direct, perc_flags = conductivity(psd, p, 1.0, eta, theory)
+    sig_tab = tables.conductivity(p, 1.0, eta, theory)
+    assert not perc_flags.any()
+    assert np.max(np.abs(sig_tab / sig_direct - 1)) < 1e-4  # issue target; measured ~5e-7
+
+
+def test_only_requested_theories_are_computed_and_stored(psd, tmp_path):
+    t = precompute(psd, theories=("average",))
+    assert t.theories == ("average",)
+    assert not any(k.endswith(("critical_junction", "emt")) for k in t.data)
+    assert "zeta_c" not in t.data
+    path = t.to_parquet(tmp_path / "avg.parquet")
+    meta = json.loads(pq.read_schema(path).metadata[b"fastcontact"])
+    assert meta["theories"] == ["average"]
+    with pytest.raises(ValueError, match="theory"):
+        t.conductivity(1e-3, 1.0, 1e-3, "emt")
+
+
+def test_flow_factor_tends_to_one_at_large_separation(tables):
+    u_targets = np.array([3.0, 5.0, 10.0, 20.0]) * tables.h_rms
+    p = tables.contact_pressure(u_targets, 1.0)
+    for theory in ("critical_junction", "emt"):
+        dev = np.abs(tables.flow_factor(p, 1.0, theory) - 1.0)
+        assert np.all(np.diff(dev) < 0), (theory, dev)
+        assert dev[-1] < 0.1
+    # second-order asymptote phi ≈ 1 - 1.5 (h/u)^2 for the effective medium (SPEC §3)
+    phi = tables.flow_factor(p[-1:], 1.0, "emt")[0]
+    assert abs((1 - phi) / (1.5 * (tables.h_rms / u_targets[-1]) ** 2) - 1) < 0.2
+
+
+def test_flow_factor_vanishes_at_percolation_while_separation_is_finite(tables, psd):
+    for theory in ("critical_junction", "emt"):
+        pp = tables.percolation_pressure(theory, 1.0)
+        p = np.array([pp * 1.0001, pp * 1.5])
+        p = p[p <= tables.p_range[1]]
+        assert np.all(tables.flow_factor(p, 1.0, theory) == 0.0)
+        assert np.all(tables.percolated(p, 1.0, theory))
+        assert np.all(np.isfinite(tables.mean_separation(p, 1.0)) & (tables.mean_separation(p, 1.0) > 0))
+
+
+def test_percolation_is_exact_in_the_direct_theories(psd):
+    pp = float(contact.percolation_pressure(psd, 1.0, 0.5))
+    # A(ζ1)/A0 at the threshold computed independently from erf(p / (2 sqrt(G1)))
+    from scipy.special import erf
+    G1 = 0.25 * math.pi * psd.moment(3.0)
+    assert abs(erf(pp / (2 * math.sqrt(G1))) - 0.5) < 1e-14
+    above = pp * (1 + 1e-9)
+    below = pp * (1 - 1e-3)
+    for theory in ("critical_junction", "emt"):
+        s, perc = conductivity(psd, [above, below], 1.0, 1e-3, theory)
+        assert s[0] == 0.0 and perc[0]
+        assert not perc[1]
+    # critical junction with a_perc = 0.42 percolates earlier
+    pp42 = float(contact.percolation_pressure(psd, 1.0, 0.42))
+    s, perc = conductivity(psd, [pp42 * (1 + 1e-9)], 1.0, 1e-3, "critical_junction", a_perc=0.42)
+    assert perc[0] and s[0] == 0.0
+
+
+def test_emt_and_critical_junction_nearly_agree_below_percolation(tables):
+    # the paper: the two give nearly the same result (here: within a factor 2) while the
+    # contact is far from percolation, A(ζ1)/A0 <= 0.3
+    p = tables.data["p_over_E"]
+    sel = tables.data["area_fraction"] <= 0.3
+    ratio = tables.data["sigma_emt"][sel] / tables.data["sigma_critical_junction"][sel]
+    assert np.all((ratio > 0.5) & (ratio < 2.0)), ratio.min()
+    assert p[sel].size > 50
+
+
+def test_parquet_round_trip_is_bit_for_bit(tables, tmp_path):
+    path = tables.to_parquet(tmp_path / "t.parquet")
+    back = Tables.from_parquet(path)
+    assert back.equals(tables, rtol=0.0)
+    assert back.grid == tables.grid and back.options == tables.options
+    schema = pq.read_schema(path)
+    assert schema.field("u_over_h").metadata[b"unit"].startswith(b"1")
+    meta = json.loads(schema.metadata[b"fastcontact"])
+    for key in ("schema_version", "fastcontact_version", "surface", "surface_hash", "grids",
+                "options", "references", "info", "units"):
+        assert key in meta
+    assert "interpolation_error" in meta["info"]
+    assert any("Lorenz" in r for r in meta["references"])
+    # evaluation after the round trip is identical
+    p = _random_pressures(tables, 10, seed=3)
+    assert np.array_equal(back.mean_separation(p, 1.0), tables.mean_separation(p, 1.0))
+
+
+def test_truncated_file_is_refused(tables, tmp_path):
+    path = tables.to_parquet(tmp_path / "t.parquet")
+    raw = path.read_bytes()
+    bad = tmp_path / "truncated.parquet"
+    bad.write_bytes(raw[: len(raw) // 2])
+    with pytest.raises(ValueError, match="truncated or corrupted"):
+        Tables.from_parquet(bad)
+
+
+def test_corrupted_file_is_refused(tables, tmp_path):
+    path = tables.to_parquet(tmp_path / "t.parquet")
+    raw = bytearray(path.read_bytes())
+    # flip bytes in the data pages (well inside the file, before the footer)
+    for k in range(200, 260):
+        raw[k] ^= 0x5A
+    bad = tmp_path / "corrupt.parquet"
+    bad.write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match="corrupt|checksum|altered"):
+        Tables.from_parquet(bad)
+
+
+def _rewrite_metadata(src, dst, mutate):
+    table = pq.read_table(src)
+    meta = json.loads(table.schema.metadata[b"fastcontact"])
+    mutate(meta)
+    table = table.replace_schema_metadata({b"fastcontact": json.dumps(meta).encode()})
+    pq.write_table(table, dst)
+
+
+def test_mismatched_surface_hash_is_refused(tables, tmp_path):
+    path = tables.to_parquet(tmp_path / "t.parquet")
+    bad = tmp_path / "mismatch.parquet"
+    _rewrite_metadata(path, bad, lambda m: m["surface"].__setitem__("h_rms", 2e-5))
+    with pytest.raises(ValueError, match="hash"):
+        Tables.from_parquet(bad)
+
+
+def test_incompatible_schema_version_is_refused(tables, tmp_path):
+    path = tables.to_parquet(tmp_path / "t.parquet")
+    bad = tmp_path / "future.parquet"
+    _rewrite_metadata(path, bad, lambda m: m.__setitem__("schema_version", 999))
+    with pytest.raises(ValueError, match="schema_version"):
+        Tables.from_parquet(bad)
+
+
+def test_write_is_atomic_and_leaves_no_partial_file(tables, tmp_path, monkeypatch):
+    import pyarrow.parquet as pq_mod
+
+    def boom(*a, **k):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(pq_mod, "write_table", boom)
+    with pytest.raises(OSError):
+        tables.to_parquet(tmp_path / "x.parquet")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_out_of_range_is_an_error_naming_the_parameter(tables):
+    lo, hi = tables.p_range
+    with pytest.raises(TableRangeError, match=r"^p = "):
+        tables.mean_separation(lo / 10, 1.0)
+    with pytest.raises(TableRangeError, match=r"^p = "):
+        tables.conductivity(hi * 10, 1.0, 1e-3, "average")
+    ulo, uhi = tables.u_range
+    with pytest.raises(TableRangeError, match=r"^u = "):
+        tables.contact_pressure(uhi * 2 * tables.h_rms, 1.0)
+
+
+def test_interpolation_kernels_flag_outside_values(tables):
+    from fastcontact.tables import k_lnu_of_lnp, k_sigma_of_lnp, k_state_of_lnu
+
+    tab = tables.kernel_data("emt")
+    lo, hi = tables.p_range
+    assert math.isnan(k_lnu_of_lnp(tab, math.log(lo) - 1.0))
+    assert math.isnan(k_sigma_of_lnp(tab, math.log(hi) + 1.0))
+    p, s, flag = k_state_of_lnu(tab, math.log(tables.u_range[1]) + 1.0)
+    assert flag == 1 and math.isnan(p)
+
+
+def test_recorded_interpolation_error_meets_the_targets(tables):
+    err = tables.info["interpolation_error"]
+    assert err["u"] <= 1e-6 and err["p_of_u"] <= 1e-6
+    for th in THEORIES:
+        assert err[f"sigma_{th}"] <= 1e-4
+
+
+@pytest.mark.parametrize("name", sorted(DEFAULT_SURFACES))
+def test_shipped_default_tables_match_a_fresh_build(name):
+    shipped = load_default_tables(name)
+    assert shipped.surface.fingerprint() == default_surface(name).fingerprint()
+    fresh = precompute(default_surface(name), theories=shipped.theories, gamma=shipped.options["gamma"],
+                       a_perc=shipped.options["a_perc"], alpha_cj=shipped.options["alpha_cj"])
+    assert fresh.equals(shipped, rtol=1e-10), f"tables/{name}.parquet is stale: run `fastcontact tables defaults`"
+    for k, v in shipped.info["interpolation_error"].items():
+        assert v <= (1e-6 if k in ("u", "p_of_u") else 1e-4), (k, v)
+
+
+def test_repository_tables_folder_matches_package_data():
+    from pathlib import Path
+
+    from fastcontact.defaults import default_table_path
+
+    repo = Path(__file__).resolve().parent.parent / "tables"
+    for name in DEFAULT_SURFACES:
+        a = Tables.from_parquet(repo / f"{name}.parquet")
+        b = Tables.from_parquet(default_table_path(name))
+        assert a.equals(b, rtol=0.0)
+
+
+def test_bad_precompute_options_name_the_parameter(psd):
+    with pytest.raises(ValueError, match="theory"):
+        precompute(psd, theories=("bogus",))
+    with pytest.raises(ValueError, match="a_perc"):
+        precompute(psd, a_perc=1.5)
+    with pytest.raises(ValueError, match="gamma"):
+        precompute(psd, gamma=0.0)
+    with pytest.raises(ValueError, match="grid"):
+        precompute(psd, grid=(0.0, -1.0, 10))
+
+
+def test_sigma_bar_direct_emt_error_estimate_is_honest(psd):
+    p = np.array([1e-9, 1e-4, 1e-2])
+    s, _, ex = sigma_bar(psd, p, "emt", tol=1e-8)
+    ref, _, _ = sigma_bar(psd, p, "emt", tol=1e-12)
+    assert np.all(np.abs(s / ref - 1) <= np.maximum(ex["error_estimate"], 1e-12) * 10)
+    assert np.all(np.abs(s / ref - 1) < 1e-7)
