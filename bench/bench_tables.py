@@ -45,7 +45,8 @@ def machine():
 def reference_points(psd, n=200, seed=0):
     g = default_grid(psd)
     rng = np.random.default_rng(seed)
-    p = np.exp(rng.uniform(g.ln_lo, g.ln_lo + g.dln * (g.n - 1), n))
+    edge = 0.3 * math.log(10.0)  # stay 0.3 decade inside every grid variant's range
+    p = np.exp(rng.uniform(g.ln_lo + edge, g.ln_lo + g.dln * (g.n - 1) - edge, n))
     u = contact.mean_separation(psd, p, 1.0) / psd.h_rms
     A = contact.area_fraction(psd, p, 1.0)
     sel = A <= 0.4

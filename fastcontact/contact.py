@@ -29,7 +29,8 @@ from .quadrature import (PANEL, area_state, gauss_legendre, m3_from, psd_value, 
 from .special import EULER_GAMMA, K_ZERO, erfinv, k_table
 
 __all__ = ["area_fraction", "mean_separation", "u1", "critical_magnification",
-           "contact_pressure", "asymptote", "stiffness_G", "percolation_pressure"]
+           "contact_pressure", "asymptote", "asymptote_self_affine", "stiffness_G",
+           "percolation_pressure", "separation_slope"]
 
 
 # --------------------------------------------------------------------------- validation
@@ -307,4 +308,30 @@ def asymptote(psd, gamma=1.0):
     if gamma != 1.0:
         beta *= math.exp(3.0 * (1.0 - gamma) * K_ZERO / gamma)
         u0 *= gamma
-    return u0, beta
+    return float(u0), float(beta)
+
+
+def asymptote_self_affine(h_rms, hurst, q0, gamma=1.0):
+    """Closed-form asymptote (u0 [m], β [-]) of a self-affine spectrum without roll-off, ζ1 → ∞.
+
+    With ``b = H/(2-2H)`` (SPEC §2, derived from the small-p limit of A4):
+    ``u0/h_rms = √(H/(π(2-2H))) B(½, b)``,
+    ``β/(q0 h_rms) = e^{-γ_E/2} √(H/(2-2H)) exp(½[ψ(½) - ψ(b)])``;
+    with γ ≠ 1, ``u0 -> γ u0`` and ``β -> β exp(3(1-γ)K(0)/γ)``.
+    For H = 0.8: u0/h_rms = 1.063846, β/(q0 h_rms) = 0.321364. A finite ζ1 changes both by
+    a relative amount of order ζ1^(-H) ln ζ1 (compare :func:`asymptote`).
+    """
+    from scipy.special import beta as beta_fn, digamma
+
+    h_rms = float(check_positive("h_rms", h_rms, "[m]"))
+    H = float(check_range("hurst", hurst, 0.0, 1.0, "[-]", lo_open=True, hi_open=True))
+    q0 = float(check_positive("q0", q0, "[1/m]"))
+    gamma = _check_gamma(gamma)
+    b = H / (2.0 - 2.0 * H)
+    u0 = h_rms * math.sqrt(H / (math.pi * (2.0 - 2.0 * H))) * beta_fn(0.5, b)
+    beta = (q0 * h_rms * math.exp(-0.5 * EULER_GAMMA) * math.sqrt(H / (2.0 - 2.0 * H))
+            * math.exp(0.5 * (digamma(0.5) - digamma(b))))
+    if gamma != 1.0:
+        beta *= math.exp(3.0 * (1.0 - gamma) * K_ZERO / gamma)
+        u0 *= gamma
+    return float(u0), float(beta)

@@ -29,7 +29,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .special import e1, erfinv, k_eval
+from .special import e1_and_exp, erfinv, k_eval
 
 #: default Gauss–Legendre order per panel and panel width in τ (see bench/bench_tables.py)
 GL_ORDER = 10
@@ -139,11 +139,12 @@ def q_for_m3(qb, c, e, cum3, target):
 def f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder):
     """F(s0) and g(s0) of the module docstring."""
     x = s0 * s0
-    ex = math.exp(-x)
     if gamma == 1.0:
-        return 0.5 * e1(x), ex
+        e1x, ex = e1_and_exp(x)
+        return 0.5 * e1x, ex
+    e1x, ex = e1_and_exp(x)
     ef = math.erf(s0)
-    F = 0.5 * gamma * e1(x) + 3.0 * (1.0 - gamma) * k_eval(s0, kt0, kdt, kval, kder, rdt, rval, rder)
+    F = 0.5 * gamma * e1x + 3.0 * (1.0 - gamma) * k_eval(s0, kt0, kdt, kval, kder, rdt, rval, rder)
     g = (gamma + 3.0 * (1.0 - gamma) * ef * ef) * ex
     return F, g
 
@@ -161,8 +162,14 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
     r = q1 / a - 1.0
     tau_hi = math.log(r)
     ia = seg_index(qb, a)
+    # the first (partial) segment's closed-form moment: pref * expm1(k ln(q/a)) / k
+    k3 = 4.0 + e[ia]
+    pref3 = c[ia] * (a / qb[ia]) ** e[ia] * a ** 4
+    lin3 = abs(k3) < 1e-12
+    end_ia = qb[ia + 1]
+    lna = math.log(a)
     # lower cut: where s0² = S2_CUT (linearised w, then checked with the exact moment)
-    ca = psd_value(qb, c, e, a)
+    ca = c[ia] * (a / qb[ia]) ** e[ia]
     dlo = P * P / (math.pi * a ** 3 * ca * S2_CUT)
     tau_lo = math.log(dlo / a)
     if tau_lo > tau_hi - 1e-3:
@@ -184,6 +191,7 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
     sg = 0.0
     sJ = 0.0
     ng = glx.size
+    iq = ia  # segment of the current node (nodes increase monotonically)
     while t0 < tau_hi:
         dist = min(abs(t0 - tau_1), abs(t0))
         width = panel * min(max(1.0, dist / GRADE), GRADE_MAX)
@@ -201,9 +209,18 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
         for j in range(ng):
             tau = mid + half * glx[j]
             delta = math.exp(tau)
+            l1p = math.log1p(delta)
             q = a * (1.0 + delta)
-            Cq = psd_value(qb, c, e, q)
-            m = m3_from(qb, c, e, cum3, a, ia, delta)
+            while iq < qb.size - 2 and q > qb[iq + 1]:
+                iq += 1
+            lnq = lna + l1p
+            Cq = c[iq] * math.exp(e[iq] * (lnq - math.log(qb[iq])))
+            if q <= end_ia:
+                m = pref3 * l1p if lin3 else pref3 * math.expm1(k3 * l1p) / k3
+            else:
+                m = (_seg_moment(c[ia], qb[ia], e[ia], 3.0, a, math.log(end_ia / a))
+                     + cum3[iq] - cum3[ia + 1]
+                     + _seg_moment(c[iq], qb[iq], e[iq], 3.0, qb[iq], lnq - math.log(qb[iq])))
             w = 1.0 / math.sqrt(math.pi * m)
             s0 = w * P
             F, g = f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder)

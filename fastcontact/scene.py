@@ -247,6 +247,8 @@ SCHEMA = {
         "p_b": _Key("num", "pressure", axis=True, studies=("seal",), lo=0),
         "profile": _Key("choice", studies=("seal",), choices=("uniform", "hertz")),
         "f_N": _Key("num", "force_per_length", axis=True, studies=("seal",), lo=0, lo_open=True),
+        "alpha_cj": _Key("num", axis=True, studies=("seal",), lo=0, lo_open=True,
+                         doc="critical-junction factor on u1 (σ scales with α_cj³)"),
     },
     "material": {
         "E": _Key("num", "pressure", axis=True, lo=0, lo_open=True),
@@ -303,7 +305,7 @@ DEFAULTS = {
     "squeeze": {"theory": "average", "ratios": (1.1, 1.01, 1.001), "du": (1e-6,), "times": ()},
     "tire": {"theory": "average", "ratios": (1.1, 1.01, 1.001), "pressure_profile": "uniform",
              "pressure_model": "mean", "du_complete": 1e-6, "u_start": 1e-2, "rho": 1000.0},
-    "seal": {"theory": "critical_junction", "p_b": 0.0, "profile": "uniform"},
+    "seal": {"theory": "critical_junction", "p_b": 0.0, "profile": "uniform", "alpha_cj": 1.0},
 }
 
 
@@ -736,8 +738,9 @@ def load_scene(scene, *, for_sweep=False, base_dir=None):
             for k in ("L", "L_y"):
                 if k not in axes and ("geometry", k) not in given:
                     problems.append(f"geometry.{k} is missing (seal study)")
-            if "p_b" not in axes and ("study", "p_b") not in given:
-                axes["p_b"] = [defaults["p_b"]]
+            for k in ("p_b", "alpha_cj"):
+                if k not in axes and ("study", k) not in given:
+                    axes[k] = [defaults[k]]
             if fixed.get("profile") == "hertz":
                 for k, sec in (("R", "geometry"), ("f_N", "study")):
                     if k not in axes and (sec, k) not in given:
@@ -762,6 +765,9 @@ def load_scene(scene, *, for_sweep=False, base_dir=None):
     # ------------------------------------------------------------ table options
     topts = {"gamma": 1.0, "a_perc": 0.5, "alpha_cj": 1.0}
     topts_given = {k: fixed.pop(k) for k in ("gamma", "a_perc", "alpha_cj") if k in fixed}
+    if kind == "seal" and ("tables", "alpha_cj") in given:
+        problems.append("tables.alpha_cj: for a seal study give the junction factor as "
+                        "study.alpha_cj (it rescales σ_cj by α_cj³ on tables built with α_cj = 1)")
     topts.update(topts_given)
     cache_dir = fixed.pop("cache_dir", None)
     if cache_dir is not None:
@@ -940,10 +946,514 @@ def available_columns(kind, fixed):
     raise ValueError(f"kind = {kind!r} is invalid")
 
 
-SQUEEZE_BASE_COLUMNS = ("u_start", "u_inf", "t_star", "trapped", "u_trap", "fluid_load_fraction")
+def _num_name(x):
+    return f"{float(x):.6g}"
+
+
+def squeeze_columns(ratios, du, times):
+    """Result columns of a squeeze study (names independent of the engine's formatting)."""
+    return (["u_start", "u_inf", "t_star"] + [f"t_ratio_{_num_name(r)}" for r in ratios]
+            + [f"t_du_{_num_name(d)}" for d in du] + [f"u_at_{_num_name(t)}" for t in times]
+            + ["trapped", "u_trap", "fluid_load_fraction"])
+
+
 SEAL_COLUMNS = ("Q", "lift_off", "percolated")
 
 
 def _squeeze_columns(ratios, du, times):
-    from .squeeze_names import ratio_col, du_col, time_col  # noqa: F401  (placeholder, see below)
-    raise NotImplementedError
+    return squeeze_columns(ratios, du, times)
+
+
+def available_figures(kind):
+    return list(FIGURES[kind])
+
+
+# =========================================================================== tables
+def _canonical_theories(theories):
+    ths = set(theories)
+    return tuple(t for t in THEORY_NAMES if t in ths)
+
+
+def table_key(psd, theories, options) -> str:
+    """Cache key: surface fingerprint + theories + table options + table schema version."""
+    from . import __version__
+    from .tables import SCHEMA_VERSION
+    blob = json.dumps({"surface": psd.fingerprint(), "theories": list(_canonical_theories(theories)),
+                       "options": {k: float(v) for k, v in sorted(options.items())},
+                       "schema": SCHEMA_VERSION, "version": __version__},
+                      sort_keys=True).encode()
+    return hashlib.sha256(blob).hexdigest()
+
+
+def build_tables(psd, theories, options):
+    """precompute(...) with the study's theories and options; returns (Tables, note).
+
+    If the adaptive refinement cannot resolve ū(p) as strictly decreasing (seen for some
+    tabulated spectra whose quadrature noise exceeds the refinement tolerance), the build is
+    retried on the base grid without refinement and ``note`` says so; the interpolation
+    errors actually achieved are in ``Tables.info["interpolation_error"]``.
+    """
+    from .tables import precompute
+    theories = _canonical_theories(theories)
+    try:
+        return precompute(psd, theories=theories, **options), None
+    except ValueError as exc:
+        if "strictly decreasing" not in str(exc):
+            raise
+        t = precompute(psd, theories=theories, refine=False, **options)
+        err = t.info.get("interpolation_error", {})
+        worst = max(err.values()) if err else float("nan")
+        return t, (f"adaptive refinement failed ({exc}); built on the base grid without "
+                   f"refinement, worst interpolation error {worst:.2g}")
+
+
+def obtain_tables(spec, theories, options, cache_dir=None):
+    """Tables for one surface: load a table file, reuse the cache or build (and cache).
+
+    Returns (Tables, record) with record = {surface, action ("loaded" | "reused" | "built"),
+    path, theories, options, surface_hash, columns_sha256, seconds, note}.
+    """
+    from .tables import Tables
+    t0 = time.perf_counter()
+    theories = _canonical_theories(theories)
+    note = None
+    if spec.source == "table":
+        T = Tables.from_parquet(spec.path)
+        action, path = "loaded", spec.path
+    else:
+        psd = spec.psd()
+        key = table_key(psd, theories, options)
+        T = None
+        path = None
+        if cache_dir is not None:
+            cdir = Path(cache_dir)
+            path = cdir / f"{psd.fingerprint()[:16]}-{key[:16]}.parquet"
+            if path.is_file():
+                try:
+                    T = Tables.from_parquet(path)
+                    ok = (T.surface.fingerprint() == psd.fingerprint()
+                          and tuple(T.theories) == theories
+                          and all(math.isclose(T.options.get(k, math.nan), v) for k, v in options.items()))
+                    if not ok:
+                        T, note = None, "cache file did not match: rebuilt"
+                except ValueError as exc:
+                    T, note = None, f"cache file unusable ({exc}): rebuilt"
+        if T is not None:
+            action = "reused"
+        else:
+            T, bnote = build_tables(psd, theories, options)
+            note = "; ".join(x for x in (note, bnote) if x) or None
+            action = "built"
+            if path is not None:
+                T.to_parquet(path)
+    meta = T.metadata()
+    rec = {"surface": spec.name, "action": action, "path": str(path) if path else None,
+           "theories": list(T.theories), "options": T.options,
+           "surface_hash": meta["surface_hash"], "columns_sha256": meta["columns_sha256"],
+           "nodes": T.info.get("nodes"), "seconds": round(time.perf_counter() - t0, 4),
+           "build_seconds": T.info.get("build_seconds"), "note": note}
+    return T, rec
+
+
+# =========================================================================== evaluation
+_ROW_ERRORS = (ValueError, RuntimeError, ArithmeticError)
+
+
+def _col(rows, name):
+    return rows[name].to_numpy(float)
+
+
+def _eval_squeeze(tables, rows, theory, fixed, columns):
+    from .squeeze import squeeze_out
+    from .tire import _pick
+    ratios = [r for r in fixed["ratios"] if f"t_ratio_{_num_name(r)}" in columns]
+    du = [d for d in fixed["du"] if f"t_du_{_num_name(d)}" in columns]
+    times = [t for t in fixed["times"] if f"u_at_{_num_name(t)}" in columns]
+    kw = dict(p0=_col(rows, "p0"), E_star=_col(rows, "E_star"), R=_col(rows, "R"),
+              eta=_col(rows, "eta"), theory=theory,
+              u_start=_col(rows, "u_start") if "u_start" in rows else None,
+              ratios=tuple(ratios) if ratios else (1.01,), du=tuple(du), times=tuple(times))
+    sq = squeeze_out(tables, **kw).reset_index(drop=True)
+    if len(sq) != len(rows):
+        raise RuntimeError(f"squeeze_out returned {len(sq)} rows for {len(rows)} cases")
+    out = {}
+    for name in ("u_start", "u_inf", "t_star", "trapped", "u_trap", "fluid_load_fraction"):
+        if name in columns:
+            if name == "u_start" and "u_start" not in sq and "u_start" in rows:
+                out[name] = _col(rows, "u_start")
+            else:
+                out[name] = sq[name].to_numpy() if name in sq else np.full(len(rows), np.nan)
+    for prefix, vals in (("t_ratio_", ratios), ("t_du_", du), ("u_at_", times)):
+        if vals:
+            for v, c in zip(vals, _pick(sq, prefix, vals)):
+                out[f"{prefix}{_num_name(v)}"] = sq[c].to_numpy()
+    return out
+
+
+def _eval_tire(tables, rows, theory, fixed, columns):
+    from .tire import tire_footprint
+    df = tire_footprint(tables, p0=_col(rows, "p0"), E_star=_col(rows, "E_star"), R=_col(rows, "R"),
+                        eta=_col(rows, "eta"), footprint_length=_col(rows, "footprint_length"),
+                        speed=_col(rows, "speed"), rho=_col(rows, "rho"), theory=theory,
+                        pressure_profile=fixed["pressure_profile"],
+                        pressure_model=fixed["pressure_model"], u_start=_col(rows, "u_start"),
+                        du_complete=fixed["du_complete"], ratios=fixed["ratios"], columns=columns)
+    return {c: df[c].to_numpy() for c in columns}
+
+
+def _eval_seal(tables, rows, theory, fixed, columns):
+    from .seal import seal_leak
+    hertz = fixed.get("profile") == "hertz"
+    kw = dict(p0=_col(rows, "p0"), dp=_col(rows, "dp"), L=_col(rows, "L"), L_y=_col(rows, "L_y"),
+              E_star=_col(rows, "E_star"), eta=_col(rows, "eta"), theory=theory,
+              alpha_cj=_col(rows, "alpha_cj"), p_b=_col(rows, "p_b"),
+              profile=fixed.get("profile", "uniform"),
+              R=_col(rows, "R") if hertz else None, f_N=_col(rows, "f_N") if hertz else None)
+    if len(rows) == 1:
+        kw = {k: (v[0] if isinstance(v, np.ndarray) else v) for k, v in kw.items()}
+    df = seal_leak(tables, **kw).reset_index(drop=True)
+    if len(df) != len(rows):
+        raise RuntimeError(f"seal_leak returned {len(df)} rows for {len(rows)} cases")
+    return {c: df[c].to_numpy() for c in columns}
+
+
+_ENGINES = {"squeeze": _eval_squeeze, "tire": _eval_tire, "seal": _eval_seal}
+
+
+def evaluate_cases(kind, tables, cases, fixed, columns):
+    """Evaluate every case (rows of ``cases``) on one surface's ``tables``.
+
+    Returns a DataFrame aligned with ``cases`` holding ``columns`` plus ``error`` ("" where
+    the case evaluated; otherwise the engine's message, and NaN results). Cases are grouped
+    by theory and evaluated vectorised; if a group fails, its cases are evaluated one by one
+    so that one bad case does not sink the others.
+    """
+    import pandas as pd
+    engine = _ENGINES[kind]
+    n = len(cases)
+    res = {c: np.full(n, np.nan, dtype=object) for c in columns}
+    err = np.full(n, "", dtype=object)
+    cases = cases.reset_index(drop=True)
+    for theory, idx in cases.groupby("theory", sort=False).indices.items():
+        rows = cases.iloc[idx].reset_index(drop=True)
+        try:
+            out = engine(tables, rows, theory, fixed, columns)
+            for c in columns:
+                res[c][idx] = out[c]
+            continue
+        except Exception:  # noqa: BLE001 - fall back to one case at a time (errors kept per row)
+            pass
+        for k, i in enumerate(idx):
+            row = rows.iloc[[k]].reset_index(drop=True)
+            try:
+                out = engine(tables, row, theory, fixed, columns)
+                for c in columns:
+                    res[c][i] = np.ravel(out[c])[0]
+            except _ROW_ERRORS as exc:
+                err[i] = f"{type(exc).__name__}: {exc}"
+    df = pd.DataFrame({c: _tidy(res[c]) for c in columns})
+    df["error"] = pd.Series(err, dtype=str)
+    return df
+
+
+def _tidy(a):
+    """object array of results → float or bool array where possible."""
+    vals = [v for v in a if not (v is None or (isinstance(v, float) and math.isnan(v)))]
+    if vals and all(isinstance(v, (bool, np.bool_)) for v in vals):
+        if len(vals) == len(a):
+            return a.astype(bool)
+        return np.array([None if not isinstance(v, (bool, np.bool_)) else bool(v) for v in a], dtype=object)
+    try:
+        return a.astype(float)
+    except (TypeError, ValueError):
+        return a
+
+
+# =========================================================================== outputs
+def _atomic_write_bytes(path: Path, data: bytes):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        _chmod_default(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def _chmod_default(path):
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(path, 0o666 & ~umask)
+
+
+def write_parquet_atomic(df, path: Path, metadata: dict | None = None):
+    """Write ``df`` to ``path`` (temporary file + os.replace) with JSON ``metadata`` under
+    the key ``fastcontact``."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    path = Path(path)
+    table = pa.Table.from_pandas(df, preserve_index=False)
+    meta = dict(table.schema.metadata or {})
+    if metadata is not None:
+        meta[b"fastcontact"] = json.dumps(metadata, sort_keys=True, default=_json_default).encode()
+    table = table.replace_schema_metadata(meta)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        pq.write_table(table, tmp)
+        _chmod_default(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def _json_default(o):
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, (Path,)):
+        return str(o)
+    if isinstance(o, tuple):
+        return list(o)
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+def provenance(scene, table_records):
+    """The key-value metadata stored with results: scene, version, table hashes, reference."""
+    from . import __version__
+    return {
+        "fastcontact_version": __version__,
+        "paper_reference": PAPER_REFERENCE,
+        "study": scene.kind,
+        "scene_source": scene.source,
+        "scene_sha256": scene.sha256,
+        "scene_toml": scene.text,
+        "scene": scene.normalized(),
+        "tables": {r["surface"]: {k: r[k] for k in ("surface_hash", "columns_sha256", "theories",
+                                                   "options", "action", "note")}
+                   for r in table_records},
+        "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "python": sys.version.split()[0],
+    }
+
+
+def _summary_text(scene, results, records, files, seconds):
+    lines = [f"fastcontact run: {scene.title}",
+             f"scene: {scene.source} (sha256 {scene.sha256[:12]})",
+             f"study: {scene.kind}; theories: {', '.join(scene.theories)}; "
+             f"{len(scene.surfaces)} surface(s) x {len(results) // max(len(scene.surfaces), 1)} case(s) "
+             f"= {len(results)} rows in {seconds:.2f} s"]
+    axes = {k: v for k, v in scene.axes.items() if len(v) > 1}
+    if axes:
+        lines.append("axes: " + ", ".join(f"{k} ({len(v)} values)" for k, v in axes.items()))
+    for r in records:
+        lines.append(f"tables {r['surface']}: {r['action']} ({', '.join(r['theories'])}; "
+                     f"{r['nodes']} nodes)" + (f" [{r['note']}]" if r.get("note") else ""))
+    nerr = int((results["error"] != "").sum())
+    if nerr:
+        first = results.loc[results["error"] != "", "error"].iloc[0]
+        lines.append(f"WARNING: {nerr} case(s) failed, e.g. {first}")
+    num = [c for c in scene.columns if c in results and results[c].dtype.kind == "f"]
+    boo = [c for c in scene.columns if c in results and results[c].dtype.kind == "b"]
+    if num or boo:
+        lines.append("")
+        lines.append("per surface: min / median / max (SI units)")
+    for name, g in results.groupby("surface", sort=False):
+        lines.append(f"  [{name}]")
+        for c in num:
+            v = g[c].to_numpy(float)
+            v = v[np.isfinite(v)]
+            if v.size:
+                lines.append(f"    {c:24s} {v.min():.4g} / {np.median(v):.4g} / {v.max():.4g}")
+            else:
+                lines.append(f"    {c:24s} (no finite value)")
+        for c in boo:
+            lines.append(f"    {c:24s} true in {int(g[c].sum())} of {len(g)} cases")
+    lines.append("")
+    lines.append("files:")
+    lines.extend(f"  {f}" for f in files)
+    return "\n".join(lines) + "\n"
+
+
+def run_scene(scene, outdir, *, cache_dir=None, log=None):
+    """Run a validated :class:`Scene`; write results, summary, build record and figures.
+
+    Returns a dict with the paths written and the results DataFrame (``"results"``).
+    Nothing is written before tables and results exist; every file is written atomically.
+    """
+    import pandas as pd
+    t0 = time.perf_counter()
+    log = log or (lambda msg: None)
+    outdir = Path(outdir)
+    cdir = table_cache_dir(cache_dir or scene.cache_dir)
+    theories = scene.theories
+    options = dict(scene.table_options)
+    tables, records = {}, []
+    for name, spec in scene.surfaces.items():
+        T, rec = obtain_tables(spec, theories, options, cdir)
+        log(f"tables {name}: {rec['action']} ({', '.join(rec['theories'])}) in {rec['seconds']:.2f} s")
+        tables[name] = T
+        records.append(rec)
+    cases = scene.cases()
+    frames = []
+    for name, T in tables.items():
+        res = evaluate_cases(scene.kind, T, cases, scene.fixed, scene.columns)
+        df = pd.concat([pd.DataFrame({"surface": name}, index=cases.index), cases, res], axis=1)
+        frames.append(df)
+    results = pd.concat(frames, ignore_index=True)
+    outdir.mkdir(parents=True, exist_ok=True)
+    meta = provenance(scene, records)
+    written = [write_parquet_atomic(results, outdir / "results.parquet", meta)]
+    fig_paths = []
+    for fig in scene.figures:
+        p = _make_scene_figure(scene, fig, tables, results, outdir / "figures")
+        fig_paths.append(p)
+        log(f"figure {fig}: {p}")
+    written += fig_paths
+    seconds = time.perf_counter() - t0
+    record = {
+        "scene": scene.source, "scene_sha256": scene.sha256, "study": scene.kind,
+        "theories_requested": list(theories), "table_options": options,
+        "tables": records,
+        "outputs": {"columns": list(scene.columns), "figures": list(scene.figures),
+                    "files": [str(p) for p in written]},
+        "cases_per_surface": len(cases), "rows": len(results),
+        "failed_rows": int((results["error"] != "").sum()), "seconds": round(seconds, 3),
+    }
+    rec_path = outdir / "build_record.json"
+    summary_path = outdir / "summary.txt"
+    files = [str(p) for p in written] + [str(rec_path), str(summary_path)]
+    _atomic_write_bytes(rec_path, json.dumps(record, indent=2, sort_keys=True,
+                                             default=_json_default).encode())
+    _atomic_write_bytes(summary_path, _summary_text(scene, results, records, files,
+                                                    seconds).encode())
+    return {"results": results, "results_path": outdir / "results.parquet",
+            "summary_path": summary_path, "build_record_path": rec_path, "figures": fig_paths,
+            "record": record}
+
+
+# =========================================================================== figures
+_MAX_CURVES = 8
+
+
+def _fig_cases(scene, results):
+    """Up to _MAX_CURVES (surface, row) pairs for curve figures: every surface, first cases."""
+    per = max(1, _MAX_CURVES // max(len(scene.surfaces), 1))
+    out = []
+    for name, g in results.groupby("surface", sort=False):
+        g = g[g["error"] == ""]
+        out.extend((name, r) for _, r in g.head(per).iterrows())
+    return out[:_MAX_CURVES]
+
+
+def _case_label(scene, name, row):
+    parts = [scene.surfaces[name].label or name] if name in scene.surfaces else [name]
+    for k, v in scene.axes.items():
+        if len(v) > 1:
+            parts.append(f"{k}={row[k]}" if k == "theory" else f"{k}={float(row[k]):.3g}")
+    return ", ".join(parts)
+
+
+def _sweep_axis(scene):
+    for k, v in scene.axes.items():
+        if k != "theory" and len(v) > 1:
+            return k
+    return None
+
+
+def _make_scene_figure(scene, fig, tables, results, figdir):
+    figdir = Path(figdir)
+    figdir.mkdir(parents=True, exist_ok=True)
+    path = figdir / f"{scene.kind}_{fig}.png"
+    if scene.kind == "tire" or (scene.kind == "squeeze" and fig == "u_of_t"):
+        from .figures.tire_figures import plot_tire_curves, tire_curve
+        curves = []
+        for name, row in _fig_cases(scene, results):
+            p_eval = float(row["p_eval"]) if "p_eval" in row else float(row["p0"])
+            if scene.kind == "tire" and "p_eval" not in row:
+                from .tire import profile_factors
+                peak = profile_factors(scene.fixed["pressure_profile"])[1]
+                p_eval = float(row["p0"]) * (peak if scene.fixed["pressure_model"] == "peak" else 1.0)
+            ratios = scene.fixed.get("ratios") or (1.1, 1.01, 1.001)
+            du = scene.fixed.get("du_complete") or (scene.fixed.get("du") or (1e-6,))[0]
+            curves.append(tire_curve(tables[name], p0=p_eval, E_star=float(row["E_star"]),
+                                     R=float(row["R"]), eta=float(row["eta"]),
+                                     theory=row["theory"],
+                                     u_start=float(row["u_start"]) if "u_start" in row and
+                                     np.isfinite(float(row["u_start"])) else None,
+                                     ratios=ratios, du=du, label=_case_label(scene, name, row)))
+        t_mark = None
+        if scene.kind == "tire":
+            t_fp = float(results["footprint_length"].iloc[0] / results["speed"].iloc[0])
+            t_mark = t_fp
+        quantity = "du" if fig == "du_of_t" else "u"
+        return plot_tire_curves(curves, path, quantity, scene.title, t_mark=t_mark,
+                                t_mark_label="time in footprint" if t_mark else None)
+    from .figures.reduced_figures import _new_figure, _save_atomic
+    f = _new_figure(figsize=(6.4, 4.8))
+    ax = f.subplots()
+    ok = results[results["error"] == ""]
+    if scene.kind == "squeeze":   # t_star
+        x = _sweep_axis(scene) or "p0"
+        for k, ((name, theory), g) in enumerate(ok.groupby(["surface", "theory"], sort=False)):
+            gg = g.sort_values(x)
+            y = gg["t_star"].to_numpy(float)
+            ax.plot(gg[x].to_numpy(float), y, "o-", ms=3, label=f"{name} ({theory})")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel(f"{x} (SI)")
+        ax.set_ylabel(r"squeeze-out time $t^*$ (s), $\bar u(t^*) = 1.01\,\bar u_\infty$")
+    elif fig == "leak_rate":
+        others = [k for k, v in scene.axes.items() if len(v) > 1 and k != "dp"]
+        for (name, *key), g in ok.groupby(["surface", *others], sort=False):
+            gg = g.sort_values("dp")
+            Q = gg["Q"].to_numpy(float)
+            m = np.isfinite(Q) & (Q > 0)
+            lab = name + "".join(f", {o}={v:.3g}" if not isinstance(v, str) else f", {v}"
+                                 for o, v in zip(others, key))
+            ax.plot((gg["dp"] / gg["p0"]).to_numpy(float)[m], Q[m], "o-", ms=3, label=lab)
+        ax.set_yscale("log")
+        ax.set_xlabel(r"$\Delta p / p_0$")
+        ax.set_ylabel(r"leak rate $Q$ (m$^3$/s)")
+    elif fig == "profiles":
+        from .seal import seal_profile
+        name, row = _fig_cases(scene, results)[0]
+        T = tables[name]
+        ax2 = ax.twinx()
+        for j, frac in enumerate((0.0, 0.5, 0.9)):
+            dp = frac * float(row["p0"])
+            prof = seal_profile(T, **_seal_profile_kwargs(scene, row, dp))
+            x = prof["x"].to_numpy(float) * 1e3
+            ax.plot(x, prof["p_cont"].to_numpy(float) / 1e3, color=COLORS_SEAL[j],
+                    label=rf"$p_{{\rm cont}}$, $\Delta p/p_0$ = {frac:g}")
+            ucol = "u" if "u" in prof else [c for c in prof.columns if c.startswith("u")][0]
+            ax2.plot(x, prof[ucol].to_numpy(float) * 1e6, color=COLORS_SEAL[j], ls="--")
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel(r"contact pressure $p_{\rm cont}$ (kPa)")
+        ax2.set_ylabel(r"separation $\bar u$ (µm), dashed")
+    ax.legend(fontsize=8, frameon=False)
+    ax.set_title(scene.title, fontsize=9)
+    ax.grid(True, which="major", lw=0.3, alpha=0.5)
+    return _save_atomic(f, path)
+
+
+COLORS_SEAL = ("tab:blue", "tab:orange", "tab:red")
+
+
+def _seal_profile_kwargs(scene, row, dp):
+    hertz = scene.fixed.get("profile") == "hertz"
+    return dict(p0=float(row["p0"]), dp=dp, L=float(row["L"]), L_y=float(row["L_y"]),
+                E_star=float(row["E_star"]), eta=float(row["eta"]), theory=row["theory"],
+                alpha_cj=float(row["alpha_cj"]), p_b=float(row["p_b"]),
+                profile=scene.fixed.get("profile", "uniform"),
+                R=float(row["R"]) if hertz else None, f_N=float(row["f_N"]) if hertz else None)

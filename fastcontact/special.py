@@ -28,10 +28,10 @@ _R_N = 1201
 
 
 @njit(cache=True)
-def e1(x):
-    """Exponential integral E1(x) for x > 0 (inf at 0, 0 beyond x = 745)."""
+def e1_and_exp(x):
+    """(E1(x), e^{-x}) for x > 0, sharing the exponential of the continued fraction."""
     if x <= 0.0:
-        return math.inf
+        return math.inf, 1.0
     if x <= 1.0:
         s = 0.0
         term = 1.0
@@ -43,9 +43,9 @@ def e1(x):
             if abs(d) < 1e-17 * abs(s) + 1e-300:
                 break
             k += 1
-        return -EULER_GAMMA - math.log(x) - s
+        return -EULER_GAMMA - math.log(x) - s, math.exp(-x)
     if x > 745.0:
-        return 0.0
+        return 0.0, 0.0
     b = x + 1.0
     c = 1e300
     d = 1.0 / b
@@ -61,7 +61,14 @@ def e1(x):
         if abs(de - 1.0) < 1e-16:
             break
         i += 1
-    return h * math.exp(-x)
+    ex = math.exp(-x)
+    return h * ex, ex
+
+
+@njit(cache=True)
+def e1(x):
+    """Exponential integral E1(x) for x > 0 (inf at 0, 0 beyond x = 745)."""
+    return e1_and_exp(x)[0]
 
 
 _GL12_X, _GL12_W = np.polynomial.legendre.leggauss(12)

@@ -32,7 +32,9 @@ Binning: area-preserving log-log tables
 The periodogram values are averaged over log-spaced bins between q_lo and q_Ny (default 10
 per decade; for a 2-D map the lattice points of each annulus, q = 0 and the FFT corners
 beyond q_Ny dropped; for line scans the inner edges are snapped to half-integer multiples of
-2π/L so that every bin holds whole lattice cells; an empty bin is merged into its neighbour).
+2π/L so that every bin holds whole lattice cells; an empty bin is merged into its neighbour;
+bins at either end whose mean is at FFT round-off level, < 1e-24 × the largest — e.g. above
+q1 of a synthetic map — are dropped, so the table then ends there instead of at q_lo / q_Ny).
 The returned table is *histopolating*: its node values at the geometric bin centres (plus
 the end nodes q_lo, flat, and q_Ny, last slope) are chosen so that the log-log interpolant
 integrates over each bin to the bin's mean times the bin's area (2-D) / length (1-D). So a
@@ -41,7 +43,8 @@ sharp roll-off kink is not rounded off — a plain interpolant through the bin m
 ~1.5 % of the variance at a roll-off with 10 bins per decade, which breaks Parseval.
 Parseval for a 2-D map (rms of the detrended heights = ``psd.h_rms``) then holds up to the
 difference between the lattice sum and the integral of C over the few lowest shells:
-≤ 0.15 % when the roll-off lies at ≥ 16·q_lo, ≤ 0.7 % at 8·q_lo (measured, 512² maps).
+≤ 0.25 % when the roll-off lies at ≥ 16·q_lo, ≤ 1 % (mean -0.5 %) at 8·q_lo (measured,
+20 Gaussian 512² maps each).
 :func:`psd_from_heights` warns (RuntimeWarning) when it is above 1 %, i.e. when the map does
 not resolve its longest wavelengths or holds roughness beyond q_Ny.
 
@@ -60,14 +63,16 @@ Whittle likelihood of the bin-averaged periodogram (weights = number of periodog
 × effective number of independent scans) plus a Gaussian prior (std 1 per node) on the
 change of log-log slope — zero for a power law, so the self-affine band is unbiased, and it
 keeps the roll-off bounded. Measured on rows of 512² / 1024² synthetic isotropic surfaces
-(H = 0.3–0.8, roll-off at 8–32·q_lo): in the self-affine band 2·q_r … q_Ny/3, all rows of one
-map: |error| ≤ 5 % (≤ 0.3 % for a map with exact amplitudes, i.e. no statistical
-scatter); 8 scans: rms 8 %, max 20 %; one scan: rms 16 %, max ~50 %. In the roll-off
-(q < q_r) the conversion is coarse (rms factor 1.3–1.8); the top ~quarter decade below q_Ny
-is biased by the missing roughness beyond q_Ny. ``psd.h_rms`` exceeds the profiles' rms by
-0.5–4 % (all rows of a map; single scans up to ~25 %): a profile misses the roughness with
-wavevector perpendicular to it (qx = 0 is removed with each scan's mean), the 2-D spectrum
-does not.
+(H = 0.3–0.8, roll-off at 8–32·q_lo), in the self-affine band 2·q_r … q_Ny/3: all rows of
+one map: rms error 4 %, worst node 11 % (exact-amplitude maps, i.e. without statistical
+scatter: ≤ 0.3 %, ≤ 3 % for H = 0.3); 8 scans: rms 8 %; one scan of 512–1024 points:
+rms 16 %, worst node a factor ~1.5. In the roll-off (q < q_r) the conversion is coarse
+(rms error a factor 1.3–1.8); the top ~quarter decade below q_Ny is biased by the missing
+roughness beyond q_Ny. ``psd.h_rms`` exceeds the profiles' rms — a profile misses the
+roughness with wavevector perpendicular to it (qx = 0 is removed with each scan's mean), the
+2-D spectrum does not — by -0.3 … +5.5 % for a roll-off at 16–32·q_lo and up to +10 % at
+8·q_lo (all rows of a map; one scan: +3 … +24 %); it matches the areal rms of the map to
+≤ 4.3 % (roll-off at 16·q_lo).
 """
 from __future__ import annotations
 
@@ -97,6 +102,8 @@ _DETRENDS = ("mean", "plane")
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 #: prior std of the change of log-log slope between neighbouring C1D nodes (line scans)
 ABEL_SLOPE_PRIOR = 1.0
+#: bins whose mean periodogram is below this fraction of the largest are FFT round-off
+ROUNDOFF_FLOOR = 1e-24
 #: |psd.h_rms / rms(heights) - 1| above which psd_from_heights warns (2-D maps, no window)
 PARSEVAL_WARN = 0.01
 
@@ -106,15 +113,16 @@ def _check_heights(heights, *, allow_1d=True, scans=False):
     h = as_float_array("heights", heights)
     if h.ndim not in ((1, 2) if allow_1d else (2,)):
         want = "a 1-D line scan or a 2-D map" if allow_1d else "a 2-D map"
-        raise ValueError(f"heights has shape {h.shape} (ndim = {h.ndim}) is invalid: must be {want}")
+        raise ValueError(f"heights has shape {h.shape} (ndim = {h.ndim}) is invalid: "
+                         f"must be {want}")
     if (h.shape[-1] if scans else min(h.shape)) < _MIN_SAMPLES:
         where = "per scan (rows are scans)" if scans else "in every dimension"
         raise ValueError(f"heights has shape {h.shape} is invalid: must have at least "
                          f"{_MIN_SAMPLES} samples {where}")
     if not np.all(np.isfinite(h)):
         idx = tuple(int(i) for i in np.argwhere(~np.isfinite(h))[0])
-        raise ValueError(f"heights = {h[idx]!r} at index {idx} is invalid: every height must be "
-                         f"finite [m] (no NaN / inf; fill or crop missing data first)")
+        raise ValueError(f"heights = {float(h[idx])!r} at index {idx} is invalid: every height "
+                         f"must be finite [m] (no NaN / inf; fill or crop missing data first)")
     return h
 
 
@@ -237,6 +245,14 @@ def _tile_bins(qk, vk, edges):
     return new, vsum / cnt, cnt
 
 
+def _trim_roundoff(edges, mean, cnt):
+    """Drop the bins at either end of the band whose mean is at FFT round-off level
+    (< :data:`ROUNDOFF_FLOOR` × the largest), e.g. above q1 or below q0 of a synthetic map."""
+    ok = np.flatnonzero(mean > ROUNDOFF_FLOOR * np.max(mean))
+    i, j = int(ok[0]), int(ok[-1])
+    return edges[i:j + 2], mean[i:j + 1], cnt[i:j + 1]
+
+
 def _table_nodes(qc, v, q_lo, q_hi):
     """Table through (qc, v), extended flat to q_lo and as the last segment's power law to q_hi."""
     if v.size >= 2:
@@ -335,6 +351,7 @@ def _spectrum_1d(rows, spacing, n_bins, window, detrend):
     if not np.any(mean > 0):
         raise ValueError("heights = constant (after detrending) is invalid: the surface must "
                          "have roughness (nonzero spectrum)")
+    edges, mean, cnt = _trim_roundoff(edges, mean, cnt)
     q, d = _histopolate(edges, mean, dim=1)
     cnt = np.concatenate((cnt[:1], cnt, cnt[-1:]))
     w = cnt * np.minimum(rows.shape[0], np.maximum(1.0, q / q_lo))
@@ -503,9 +520,10 @@ def abel_fit(q, c1d, weights, *, slope_prior=None):
     ``½ Σ (Δs/slope_prior)²`` on the change of log-log slope of C between neighbouring nodes
     (zero for a power law, so a self-affine band is not biased; default
     :data:`ABEL_SLOPE_PRIOR`). Solved by Fisher scoring (Gauss–Newton) on ln C with the
-    analytic Jacobian and backtracking, starting from :func:`abel_invert` of the log-smoothed data. Unlike the direct inversion
-    it is unbiased for few-sample bins (ln of an exponential variable is biased by -0.58)
-    and it keeps C positive and bounded where C1D is nearly flat (the roll-off).
+    analytic Jacobian and backtracking, starting from :func:`abel_invert` of the
+    log-smoothed data. Unlike the direct inversion it is unbiased for few-sample bins (ln of
+    an exponential variable is biased by -0.58) and it keeps C positive and bounded where
+    C1D is nearly flat (the roll-off).
     """
     q = np.asarray(q, float)
     d = np.asarray(c1d, float)
@@ -594,11 +612,12 @@ def psd_from_heights(heights, spacing, *, n_bins=None, window=None, line_scans=F
 
     Accuracy (details and measurements in the module doc)
     --------
-    2-D map: ``psd.h_rms`` equals the rms of the detrended heights to ≤ 0.15 % (roll-off at
-    ≥ 16·q_lo) / ≤ 0.7 % (8·q_lo); energy beyond q_Ny (FFT corners) is not represented; a
+    2-D map: ``psd.h_rms`` equals the rms of the detrended heights to ≤ 0.25 % (roll-off at
+    ≥ 16·q_lo) / ≤ 1 % (8·q_lo); energy beyond q_Ny (FFT corners) is not represented; a
     RuntimeWarning is issued above 1 %. Line scans: the regularised Abel fit recovers C in
-    the self-affine band to a few % from many scans (~15 % rms from one scan); ``psd.h_rms``
-    exceeds the profiles' rms by 0.5–4 % (they miss the roughness perpendicular to them).
+    the self-affine band to ~4 % rms from many scans (~16 % rms from one scan); ``psd.h_rms``
+    exceeds the profiles' rms by up to ~5 % (roll-off ≥ 16·q_lo; ~10 % at 8·q_lo): they miss
+    the roughness perpendicular to them.
     """
     if not isinstance(line_scans, (bool, np.bool_)):
         raise ValueError(f"line_scans = {line_scans!r} is invalid: must be True or False")
@@ -634,6 +653,7 @@ def psd_from_heights(heights, spacing, *, n_bins=None, window=None, line_scans=F
         raise ValueError(f"heights is invalid: must have roughness between q_lo = {q_lo:.4g} and "
                          f"the Nyquist wavevector {q_hi:.4g} [1/m] (all of it is in the FFT "
                          f"corners)")
+    edges, mean, _ = _trim_roundoff(edges, mean, np.zeros(mean.size))
     q, C = _histopolate(edges, mean, dim=2)
     psd = TabulatedPSD(q, C, convention="persson")
     if window is None:
@@ -740,7 +760,8 @@ def read_psd(path, convention=None, *, q_col=None, C_col=None):
         try:
             table = pq.read_table(path)
         except Exception as exc:
-            raise ValueError(f"path = {path!r} is invalid: cannot read as Parquet ({exc})") from None
+            raise ValueError(f"path = {path!r} is invalid: cannot read as Parquet "
+                             f"({exc})") from None
         meta = table.schema.metadata or {}
         stored = meta.get(CONVENTION_KEY)
         if stored is not None:

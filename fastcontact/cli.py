@@ -1,0 +1,362 @@
+"""Command-line interface: ``fastcontact <command> ...``.
+
+Commands
+--------
+``fastcontact run SCENE -o OUTDIR``            run a scene (a TOML file or a shipped example name)
+``fastcontact run --default -o OUTDIR``        run the default scene on the embedded tables
+``fastcontact validate SCENE``                 check a scene, write nothing
+``fastcontact scenes [NAME]``                  list the shipped example scenes (or print one)
+``fastcontact tables build ... -o OUT.parquet``  tabulate a surface (self-affine or PSD file)
+``fastcontact tables info FILE``               show a table file's metadata
+``fastcontact sweep DB -o OUT --scene S.toml [--scheduler ADDR] [--workers N]``
+``fastcontact roaddb generate PATH --n N --seed S``  synthetic road database
+``fastcontact roaddb info PATH``               summary of a road database
+``fastcontact figures -o OUTDIR``              regenerate every paper figure
+
+Bad input (invalid scene, missing file, wrong option) exits with code 2 and a one-line
+message on stderr, no traceback.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+__all__ = ["main", "build_parser"]
+
+EXIT_BAD_INPUT = 2
+
+
+class CLIError(ValueError):
+    """Bad command-line input."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2
+        raise CLIError(f"{self.prog}: {message}")
+
+
+def _quantity(dim):
+    def conv(text):
+        from .scene import parse_quantity
+        try:
+            return parse_quantity("value", text, dim)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc).replace("value = ", "")) from None
+    conv.__name__ = dim
+    return conv
+
+
+def build_parser():
+    p = _Parser(prog="fastcontact", description="Persson contact mechanics, fluid squeeze-out "
+                "and seal leakage between rough surfaces (Lorenz & Persson 2010).")
+    from . import __version__
+    p.add_argument("--version", action="version", version=f"fastcontact {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    r = sub.add_parser("run", help="run a scene (TOML) and write results, summary and figures")
+    r.add_argument("scene", nargs="?", help="scene file or shipped example name")
+    r.add_argument("--default", action="store_true", help="run the default scene (embedded tables)")
+    r.add_argument("-o", "--outdir", required=True, help="output folder")
+    r.add_argument("--cache-dir", help="table cache (default $FASTCONTACT_CACHE_DIR or "
+                   "~/.cache/fastcontact/tables)")
+    r.add_argument("-q", "--quiet", action="store_true")
+
+    v = sub.add_parser("validate", help="validate a scene; report every problem; write nothing")
+    v.add_argument("scene")
+
+    s = sub.add_parser("scenes", help="list the shipped example scenes, or print one")
+    s.add_argument("name", nargs="?")
+
+    t = sub.add_parser("tables", help="build or inspect contact/flow tables")
+    tsub = t.add_subparsers(dest="tables_command", metavar="SUBCOMMAND", parser_class=_Parser)
+    tb = tsub.add_parser("build", help="tabulate one surface")
+    tb.add_argument("--h-rms", type=_quantity("length"), help="rms roughness (m, or e.g. '0.72 mm')")
+    tb.add_argument("--hurst", type=float, help="Hurst exponent H")
+    tb.add_argument("--q0", type=_quantity("wavevector"), help="smallest wavevector [1/m]")
+    tb.add_argument("--q1", type=_quantity("wavevector"), help="largest wavevector [1/m]")
+    tb.add_argument("--q-roll", type=_quantity("wavevector"), help="roll-off wavevector [1/m]")
+    tb.add_argument("--psd", help="PSD file (.csv or .parquet with columns q, C)")
+    tb.add_argument("--convention", choices=("persson", "surface_topography"),
+                    help="normalisation of the PSD file's C")
+    tb.add_argument("--theories", nargs="+", default=["average", "critical_junction", "emt"],
+                    help="flow theories to tabulate (space or comma separated)")
+    tb.add_argument("--gamma", type=float, default=1.0, help="Yang-Persson factor (1 = paper)")
+    tb.add_argument("--a-perc", type=float, default=0.5, help="percolation threshold A/A0")
+    tb.add_argument("--alpha-cj", type=float, default=1.0, help="critical-junction factor")
+    tb.add_argument("-o", "--output", required=True, help="output .parquet file")
+    ti = tsub.add_parser("info", help="show a table file's metadata")
+    ti.add_argument("file")
+    ti.add_argument("--json", action="store_true", help="print the raw metadata as JSON")
+
+    w = sub.add_parser("sweep", help="evaluate a scene on every surface of a road database (Dask)")
+    w.add_argument("database", help="road database (Parquet dataset or folder of PSD files)")
+    w.add_argument("-o", "--outdir", required=True)
+    w.add_argument("--scene", required=True, help="scene file or shipped example name")
+    w.add_argument("--scheduler", help="address of an existing Dask scheduler")
+    w.add_argument("--workers", type=int, help="local worker processes (default: cores)")
+    w.add_argument("--convention", choices=("persson", "surface_topography"),
+                   help="C convention of database files that record none")
+    w.add_argument("--cache-dir", help="keep/reuse the tables there (default: not kept)")
+    w.add_argument("--no-progress", action="store_true")
+
+    f = sub.add_parser("figures", help="regenerate every paper figure the engine makes")
+    f.add_argument("-o", "--outdir", required=True)
+
+    d = sub.add_parser("roaddb", help="road databases")
+    dsub = d.add_subparsers(dest="roaddb_command", metavar="SUBCOMMAND", parser_class=_Parser)
+    dg = dsub.add_parser("generate", help="write a synthetic road database")
+    dg.add_argument("path")
+    dg.add_argument("-n", "--n", dest="n", type=int, required=True, help="number of surfaces")
+    dg.add_argument("--seed", type=int, required=True)
+    dg.add_argument("--n-q", type=int, default=None, help="samples per spectrum")
+    dg.add_argument("--convention", choices=("persson", "surface_topography"), default="persson")
+    di = dsub.add_parser("info", help="summarise a road database")
+    di.add_argument("path")
+    di.add_argument("--convention", choices=("persson", "surface_topography"))
+    return p
+
+
+# ============================================================================ commands
+def _cmd_run(a, out, err):
+    from .scene import example_scene_path, load_scene, run_scene
+    if a.default and a.scene:
+        raise CLIError("fastcontact run: give a scene or --default, not both")
+    if not a.default and not a.scene:
+        raise CLIError("fastcontact run: give a scene file (or --default)")
+    scene = load_scene(example_scene_path("default") if a.default else a.scene)
+    log = (lambda m: None) if a.quiet else (lambda m: print(m, file=err))
+    res = run_scene(scene, a.outdir, cache_dir=a.cache_dir, log=log)
+    print(f"results: {res['results_path']} ({len(res['results'])} rows)", file=out)
+    print(f"summary: {res['summary_path']}", file=out)
+    print(f"build record: {res['build_record_path']}", file=out)
+    for p in res["figures"]:
+        print(f"figure: {p}", file=out)
+    nerr = res["record"]["failed_rows"]
+    if nerr:
+        print(f"warning: {nerr} case(s) failed; see the 'error' column", file=err)
+    return 0
+
+
+def _cmd_validate(a, out, err):
+    from .scene import load_scene
+    sc = load_scene(a.scene)
+    n = len(sc.cases())
+    print(f"{sc.source}: valid {sc.kind} scene, {len(sc.surfaces)} surface(s) x {n} case(s), "
+          f"theories {', '.join(sc.theories)}", file=out)
+    return 0
+
+
+def _cmd_scenes(a, out, err):
+    from .scene import example_scene_path, list_example_scenes
+    if a.name:
+        print(example_scene_path(a.name).read_text(), file=out, end="")
+        return 0
+    for n in list_example_scenes():
+        p = example_scene_path(n)
+        first = p.read_text().splitlines()[0] if p.read_text() else ""
+        print(f"{n:24s} {first.lstrip('# ').strip()}", file=out)
+    return 0
+
+
+def _split_theories(vals):
+    out = []
+    for v in vals:
+        out.extend(x for x in v.split(",") if x)
+    return out
+
+
+def _cmd_tables_build(a, out, err):
+    from .tables import precompute
+    sa = {"--h-rms": a.h_rms, "--hurst": a.hurst, "--q0": a.q0, "--q1": a.q1}
+    if a.psd is not None:
+        if any(v is not None for v in list(sa.values()) + [a.q_roll]):
+            raise CLIError("fastcontact tables build: give either --psd FILE --convention X or "
+                           "--h-rms --hurst --q0 --q1 [--q-roll], not both")
+        if a.convention is None:
+            raise CLIError("fastcontact tables build: --psd needs --convention persson|"
+                           "surface_topography")
+        from .topography import read_psd
+        psd = read_psd(a.psd, a.convention)
+    else:
+        missing = [k for k, v in sa.items() if v is None]
+        if missing:
+            raise CLIError(f"fastcontact tables build: missing {', '.join(missing)} "
+                           f"(or give --psd FILE --convention X)")
+        if a.convention is not None:
+            raise CLIError("fastcontact tables build: --convention is only used with --psd")
+        from .psd import SelfAffinePSD
+        psd = SelfAffinePSD(a.h_rms, a.hurst, a.q0, a.q1, a.q_roll)
+    if not str(a.output).endswith(".parquet"):
+        raise CLIError(f"fastcontact tables build: -o {a.output!r} must end in .parquet")
+    theories = _split_theories(a.theories)
+    print(f"building tables for {psd!r}, theories {theories} ...", file=err)
+    T = precompute(psd, theories=theories, gamma=a.gamma, a_perc=a.a_perc, alpha_cj=a.alpha_cj)
+    T.to_parquet(a.output)
+    print(f"wrote {a.output} ({T.info['nodes']} nodes, {T.info['build_seconds']:.2f} s)", file=out)
+    return 0
+
+
+def _fmt_dict(d):
+    return ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}" for k, v in d.items())
+
+
+def tables_info_text(path):
+    """Readable summary of a tables file's metadata (validated by Tables.from_parquet)."""
+    from .tables import Tables
+    T = Tables.from_parquet(path)
+    m = T.metadata()
+    s, info = T.surface, T.info
+    g = T.grid
+    lines = [f"file: {path}",
+             f"surface: {s!r}",
+             f"  kind: {m['surface'].get('kind')}; h_rms = {s.h_rms:.6g} m; q0 = {s.q0:.6g} 1/m; "
+             f"q1 = {s.q1:.6g} 1/m; rms slope = {s.rms_slope:.6g}",
+             f"  surface hash: {m['surface_hash']}",
+             f"theories: {', '.join(T.theories)}",
+             f"options: {_fmt_dict(T.options)}",
+             f"grid: p/E* from {T.p_range[0]:.4g} to {T.p_range[1]:.4g} ({info.get('nodes')} nodes; "
+             f"base grid 10^{g.log10_min:g}..10^{g.log10_max:g} with {g.n} nodes, "
+             f"{info.get('refinement_rounds')} refinement rounds)",
+             f"  u/h_rms from {T.u_range[0]:.4g} to {T.u_range[1]:.4g}"]
+    err = info.get("interpolation_error", {})
+    if err:
+        lines.append("interpolation errors (max relative, interval midpoints): " + _fmt_dict(err))
+    tol = info.get("tolerance")
+    if tol:
+        lines.append("tolerances: " + _fmt_dict(tol))
+    perc = info.get("percolation_p_over_E", {})
+    if perc:
+        lines.append("percolation pressure p/E*: " + ", ".join(
+            f"{k} = {'never' if not math.isfinite(v) else format(v, '.6g')}" for k, v in perc.items()))
+    if "asymptote_u0_over_h" in info:
+        lines.append(f"asymptote (eq. 3): u0/h_rms = {info['asymptote_u0_over_h']:.6g}, "
+                     f"beta = {info['asymptote_beta']:.6g}")
+    bs = info.get("build_seconds")
+    lines.append(f"build time: {bs:.3f} s" if isinstance(bs, (int, float)) else "build time: ?")
+    lines.append(f"fastcontact version: {m['fastcontact_version']} (schema {m['schema_version']})")
+    lines.append(f"columns sha256: {m['columns_sha256']}")
+    lines.append("references:")
+    lines.extend(f"  - {r}" for r in m.get("references", []))
+    return "\n".join(lines) + "\n"
+
+
+def _cmd_tables_info(a, out, err):
+    if a.json:
+        from .tables import Tables
+        print(json.dumps(Tables.from_parquet(a.file).metadata(), indent=1, sort_keys=True,
+                         default=str), file=out)
+    else:
+        print(tables_info_text(a.file), file=out, end="")
+    return 0
+
+
+def _cmd_sweep(a, out, err):
+    from .sweep import run_sweep
+    man = run_sweep(a.database, a.outdir, a.scene, scheduler=a.scheduler, workers=a.workers,
+                    convention=a.convention, cache_dir=a.cache_dir,
+                    progress=not a.no_progress, log=lambda m: print(m, file=err))
+    print(f"sweep {man['status']}: {len(man['partitions'])}/{man['n_surfaces']} surfaces, "
+          f"{man['rows']} rows in {a.outdir}/data (manifest {a.outdir}/manifest.json)", file=out)
+    if man["failed"]:
+        print(f"error: {len(man['failed'])} surface task(s) crashed, e.g. "
+              f"{next(iter(man['failed'].items()))}; rerun to retry", file=err)
+        return 1
+    if man["surfaces_with_errors"]:
+        print(f"warning: {len(man['surfaces_with_errors'])} surface(s) have error rows "
+              f"(see the 'error' column and the manifest)", file=err)
+    return 0
+
+
+FIGURE_MODULES = (
+    ("fastcontact.figures.reduced_figures", "make_reduced_figures"),
+    ("fastcontact.figures.squeeze_figures", "make_squeeze_figures"),
+    ("fastcontact.figures.tire_figures", "make_tire_figures"),
+    ("fastcontact.figures.seal_figures", "make_seal_figures"),
+)
+
+
+def _cmd_figures(a, out, err):
+    import importlib
+    outdir = Path(a.outdir)
+    funcs = []
+    for mod, fn in FIGURE_MODULES:   # import all first: a missing module fails before any work
+        try:
+            m = importlib.import_module(mod)
+        except ModuleNotFoundError as exc:
+            if exc.name and mod.startswith(exc.name):
+                raise SystemExit(f"fastcontact figures: figure module {mod} is missing "
+                                 f"({exc}); cannot regenerate every paper figure") from None
+            raise
+        if not hasattr(m, fn):
+            raise SystemExit(f"fastcontact figures: {mod} has no {fn}()")
+        funcs.append((mod, getattr(m, fn)))
+    n = 0
+    for mod, fn in funcs:
+        print(f"{mod} ...", file=err)
+        for p in fn(outdir) or []:
+            print(f"figure: {p}", file=out)
+            n += 1
+    print(f"{n} figures in {outdir}", file=out)
+    return 0
+
+
+def _cmd_roaddb_generate(a, out, err):
+    from .roaddb import generate_road_database, N_Q
+    p = generate_road_database(a.path, a.n, a.seed, n_q=a.n_q or N_Q, convention=a.convention)
+    print(f"wrote road database {p} ({a.n} surfaces, seed {a.seed})", file=out)
+    return 0
+
+
+def _cmd_roaddb_info(a, out, err):
+    from .roaddb import open_road_database
+    db = open_road_database(a.path, a.convention)
+    import numpy as np
+    h = []
+    for sid in db.ids:
+        q, C = db.spectrum(sid)
+        h.append(math.sqrt(2 * math.pi * np.sum(0.5 * (q[1:] * C[1:] + q[:-1] * C[:-1]) * np.diff(q))))
+    h = np.array(h)
+    print(f"{db.path}: {len(db)} surfaces ({db.ids[0]} ... {db.ids[-1]}); h_rms (trapezoid) "
+          f"{h.min() * 1e3:.3g}..{h.max() * 1e3:.3g} mm; fingerprint {db.fingerprint[:16]}", file=out)
+    return 0
+
+
+def main(argv=None, out=None, err=None):
+    """Entry point; returns the exit code (0 ok, 1 failure, 2 bad input)."""
+    out = out or sys.stdout
+    err = err or sys.stderr
+    parser = build_parser()
+    try:
+        a = parser.parse_args(argv)
+        if a.command is None:
+            parser.print_help(out)
+            return EXIT_BAD_INPUT
+        if a.command == "tables":
+            cmd = {"build": _cmd_tables_build, "info": _cmd_tables_info}.get(a.tables_command)
+        elif a.command == "roaddb":
+            cmd = {"generate": _cmd_roaddb_generate, "info": _cmd_roaddb_info}.get(a.roaddb_command)
+        else:
+            cmd = {"run": _cmd_run, "validate": _cmd_validate, "scenes": _cmd_scenes,
+                   "sweep": _cmd_sweep, "figures": _cmd_figures}[a.command]
+        if cmd is None:
+            raise CLIError(f"fastcontact {a.command}: give a subcommand (see --help)")
+        return cmd(a, out, err)
+    except (ValueError, FileNotFoundError) as exc:
+        # bad input: SceneError, SweepError, CLIError, TableRangeError, ValueError from
+        # validation ... — one line, no traceback
+        msg = str(exc)
+        msg = " ".join(msg.split())
+        prefix = "" if msg.startswith("fastcontact") else "fastcontact: error: "
+        print(prefix + msg, file=err)
+        return EXIT_BAD_INPUT
+
+
+def _entry():  # pragma: no cover
+    sys.exit(main())
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

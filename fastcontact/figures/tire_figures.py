@@ -1,0 +1,163 @@
+"""Tire tread block on a wet road — the paper's Sec. 5 figures (two asphalt surfaces).
+
+``make_tire_figures(outdir, tables=None)`` writes
+
+* ``tire_u_of_t.png``: ū(t) against t, log–log, for the two asphalt roads (h_rms = 0.72 mm,
+  surface 1; 0.24 mm, surface 2), with vertical lines where ū/ū∞ = 1.1, 1.01, 1.001 and thin
+  lines for perfectly flat surfaces (Stefan law from the same ū(0));
+* ``tire_du_of_t.png``: Δu = ū(t) - ū∞ against t, log–log, with the 1 µm level and the
+  footprint time (0.1 m at 30 m/s) marked.
+
+Parameters (paper Sec. 5): p0 = 0.2 MPa, E = 10 MPa with ν = 0.5 (rubber; E* = E/(1-ν²) =
+13.3 MPa), R = 2 cm, water η = 1 mPa·s, average-separation theory, ū(0) = 1 cm.
+The roads are the embedded stand-in tables ``asphalt_072mm`` and ``asphalt_024mm`` (see
+:mod:`fastcontact.defaults`) unless ``tables`` = {label: Tables} is given.
+
+Rendering uses the Agg canvas directly (no pyplot); PNGs are written atomically.
+Run as a script: ``python -m fastcontact.figures.tire_figures [outdir]``.
+"""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["make_tire_figures", "tire_curve", "plot_tire_curves", "PAPER"]
+
+PAPER = dict(p0=0.2e6, E=10e6, nu=0.5, R=0.02, eta=1e-3, rho=1000.0, u_start=1e-2,
+             footprint_length=0.1, speed=30.0, theory="average", ratios=(1.1, 1.01, 1.001),
+             du_complete=1e-6)
+ROADS = (("asphalt_072mm", r"surface 1: $h_{\rm rms}$ = 0.72 mm"),
+         ("asphalt_024mm", r"surface 2: $h_{\rm rms}$ = 0.24 mm"))
+COLORS = ("tab:red", "tab:blue", "tab:green", "tab:purple", "tab:orange", "tab:brown",
+          "tab:pink", "tab:olive")
+
+
+def _save_atomic(fig, path):
+    from fastcontact.figures.reduced_figures import _save_atomic as save
+    return save(fig, Path(path))
+
+
+def _new_figure(**kw):
+    from fastcontact.figures.reduced_figures import _new_figure as new
+    return new(**kw)
+
+
+def tire_curve(tables, *, p0, E_star, R, eta, theory="average", u_start=PAPER["u_start"],
+               ratios=PAPER["ratios"], du=PAPER["du_complete"], label="", n=400):
+    """ū(t), Δu(t), flat-surface ū(t), ū∞ and the ratio/Δu times of one tread-block case.
+
+    The time axis spans from well before the film starts to thin to 10× the last ratio time
+    (or to 1e3× the first if the fluid is trapped).
+    """
+    from fastcontact.reduced import flat_separation
+    from fastcontact.squeeze import squeeze_history, squeeze_out
+    sq = squeeze_out(tables, p0=p0, E_star=E_star, R=R, eta=eta, theory=theory, u_start=u_start,
+                     ratios=tuple(ratios), du=(du,), times=())
+    row = sq.iloc[0]
+    from fastcontact.tire import _pick
+    t_r = [float(row[c]) for c in _pick(sq, "t_ratio_", list(ratios))]
+    t_du = float(row[_pick(sq, "t_du_", [du])[0]])
+    u_inf = float(row["u_inf"])
+    u0 = float(row["u_start"]) if "u_start" in sq else float(u_start)
+    finite = [t for t in t_r + [t_du] if math.isfinite(t) and t > 0]
+    t_hi = 10.0 * max(finite) if finite else 1.0
+    # the film starts to thin when 4 u0² p0 t/(3ηR²) ~ 1 (flat-surface law)
+    t_thin = 3.0 * eta * R ** 2 / (4.0 * u0 ** 2 * p0)
+    t_lo = min(t_thin * 1e-2, (min(finite) if finite else t_hi) * 1e-3)
+    t = np.logspace(math.log10(t_lo), math.log10(t_hi), n)
+    h = squeeze_history(tables, p0, E_star, R, eta, theory, t, u_start=u_start)
+    u = h["u"].to_numpy(float)
+    flat = np.asarray(flat_separation(u0, t, p0, eta, R), float)
+    return dict(label=label, t=t, u=u, du=u - u_inf, flat=flat, u_inf=u_inf, u_start=u0,
+                t_ratios=dict(zip(ratios, t_r)), t_du=t_du, du_level=du,
+                trapped=bool(row["trapped"]) if "trapped" in sq else False)
+
+
+def plot_tire_curves(curves, path, quantity="u", title="", t_mark=None, t_mark_label=None):
+    """Log–log plot of ū(t) (``quantity="u"``) or Δu(t) (``"du"``) for several curves.
+
+    Vertical dashed lines at the ratio times (1.1, 1.01, 1.001 from left to right), thin lines
+    for flat surfaces (ū plot), the Δu level (Δu plot) and an optional time mark
+    (e.g. the footprint time).
+    """
+    import matplotlib.ticker
+    fig = _new_figure(figsize=(6.4, 4.8))
+    ax = fig.subplots()
+    styles = ("--", "-.", ":")
+    ymin, ymax = np.inf, 0.0
+    for k, c in enumerate(curves):
+        col = COLORS[k % len(COLORS)]
+        t = c["t"]
+        if quantity == "u":
+            y = c["u"] * 1e3
+            ax.plot(t, c["flat"] * 1e3, color=col, lw=0.6, alpha=0.8)
+            ax.axhline(c["u_inf"] * 1e3, color=col, lw=0.5, ls=":", alpha=0.7)
+        else:
+            y = c["du"] * 1e6
+        ok = np.isfinite(y) & (y > 0)
+        ax.plot(t[ok], y[ok], color=col, lw=1.8, label=c["label"])
+        if ok.any():
+            ymin, ymax = min(ymin, y[ok].min()), max(ymax, y[ok].max())
+        for j, (r, tr) in enumerate(c["t_ratios"].items()):
+            if math.isfinite(tr):
+                ax.axvline(tr, color=col, lw=0.8, ls=styles[j % 3], alpha=0.9)
+    if quantity == "du":
+        lvl = curves[0]["du_level"] * 1e6 if curves else 1.0
+        ax.axhline(lvl, color="k", lw=0.8, ls=":")
+        ax.annotate(rf"$\Delta u$ = {lvl:g} µm", xy=(0.02, lvl), xycoords=("axes fraction", "data"),
+                    xytext=(0, 3), textcoords="offset points", fontsize=8)
+        ymin = min(ymin, lvl / 10)
+        ax.set_ylabel(r"$\Delta u = \bar u(t) - \bar u(\infty)$ (µm)")
+    else:
+        ax.set_ylabel(r"separation $\bar u$ (mm)")
+    if t_mark is not None:
+        ax.axvline(t_mark, color="0.3", lw=1.2)
+        ax.annotate(t_mark_label or "", xy=(t_mark, 0.97), xycoords=("data", "axes fraction"),
+                    xytext=(-3, 0), textcoords="offset points", ha="right", va="top",
+                    fontsize=8, color="0.3", rotation=90)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    if np.isfinite(ymin) and ymax > 0:
+        ax.set_ylim(ymin / 1.5, ymax * 1.5)
+    ax.set_xlabel(r"squeeze time $t$ (s)")
+    ax.plot([], [], color="0.4", lw=0.8, ls="--", label=r"$\bar u/\bar u_\infty$ = 1.1, 1.01, 1.001 (- -, -., :)")
+    if quantity == "u":
+        ax.plot([], [], color="0.4", lw=0.6, label="flat surfaces")
+    ax.legend(loc="lower left", fontsize=8, frameon=False)
+    if title:
+        ax.set_title(title, fontsize=9)
+    ax.grid(True, which="major", lw=0.3, alpha=0.5)
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    return _save_atomic(fig, path)
+
+
+def make_tire_figures(outdir, tables=None) -> list[Path]:
+    """Write the paper's two tire figures (Sec. 5) into ``outdir``; return the paths.
+
+    ``tables``: optional {label: Tables}; default the embedded asphalt tables.
+    """
+    from fastcontact.elasticity import effective_modulus
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    if tables is None:
+        from fastcontact.scene import default_table_path
+        from fastcontact.tables import Tables
+        tables = {label: Tables.from_parquet(default_table_path(name)) for name, label in ROADS}
+    E_star = effective_modulus(PAPER["E"], PAPER["nu"])
+    curves = [tire_curve(T, p0=PAPER["p0"], E_star=E_star, R=PAPER["R"], eta=PAPER["eta"],
+                         theory=PAPER["theory"], u_start=PAPER["u_start"], label=label)
+              for label, T in tables.items()]
+    t_fp = PAPER["footprint_length"] / PAPER["speed"]
+    title = (r"tread block on wet asphalt: $p_0$ = 0.2 MPa, $E$ = 10 MPa, $R$ = 2 cm, water, "
+             r"average-separation $\sigma_{\rm eff}$")
+    return [plot_tire_curves(curves, outdir / "tire_u_of_t.png", "u", title),
+            plot_tire_curves(curves, outdir / "tire_du_of_t.png", "du", title, t_mark=t_fp,
+                             t_mark_label="footprint 0.1 m at 30 m/s")]
+
+
+if __name__ == "__main__":  # pragma: no cover
+    for p in make_tire_figures(sys.argv[1] if len(sys.argv) > 1 else "."):
+        print(p)
