@@ -30,8 +30,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
-import tempfile
 import time
 from pathlib import Path
 
@@ -42,6 +40,7 @@ from . import __version__
 from ._validate import check_positive, check_range
 from .conductivity import EMT_TOL, THEORIES, check_theory, sigma_bar
 from .contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
+from .atomic import atomic_path
 from .grids import Grid, build_bucket_map, hermite_interval, locate_asc, locate_desc
 from .psd import PSD, psd_from_dict
 
@@ -377,19 +376,8 @@ class Tables:
             arrays.append(arr)
         meta = {METADATA_KEY: json.dumps(self.metadata(), sort_keys=True).encode()}
         table = pa.Table.from_arrays(arrays, schema=pa.schema(fields, metadata=meta))
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-        os.close(fd)
-        try:
+        with atomic_path(path) as tmp:
             pq.write_table(table, tmp, write_page_checksum=True)
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(tmp, 0o666 & ~umask)
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
         return path
 
     @classmethod
