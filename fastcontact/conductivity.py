@@ -57,7 +57,7 @@ def critical_junction_kernel(qb, c, e, cum3, kinks, pbar, gamma, a_perc, ktab, g
                              u1c, zeta_c, percolated):
     """u1(ζc) [m] and ζc per reduced pressure; percolated where A(ζ1)/A0 >= a_perc."""
     for i in prange(pbar.size):
-        work = np.empty(3)
+        work = np.empty(4)
         if _area1(cum3, pbar[i]) >= a_perc:
             u1c[i] = 0.0
             zeta_c[i] = math.inf
@@ -214,7 +214,7 @@ def emt_sigma(qb, c, e, cum3, kinks, pbar, h_rms, gamma, ktab, glx, glw, panel, 
     WG = np.empty(cap)
     pt0 = np.empty(EMT_MAX_PANELS)
     pt1 = np.empty(EMT_MAX_PANELS)
-    work = np.empty(3)
+    work = np.empty(4)
     npan = n_start
     for k in range(npan):
         pt0[k] = k / npan

@@ -59,8 +59,8 @@ def _arrays(psd):
 # --------------------------------------------------------------------------- kernels
 @njit(cache=True)
 def _mean_separation_kernel(qb, c, e, cum3, kinks, pbar, zeta, gamma, ktab, glx, glw, panel,
-                            out, dout):
-    work = np.empty(3)
+                            out, dout, d2out):
+    work = np.empty(4)
     q0 = qb[0]
     for i in range(pbar.size):
         a = zeta[i] * q0
@@ -68,11 +68,12 @@ def _mean_separation_kernel(qb, c, e, cum3, kinks, pbar, zeta, gamma, ktab, glx,
         separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, panel, work)
         out[i] = work[0]
         dout[i] = -work[1]
+        d2out[i] = -work[3]
 
 
 @njit(cache=True)
 def _u1_kernel(qb, c, e, cum3, kinks, pbar, zeta, gamma, ktab, glx, glw, panel, out):
-    work = np.empty(3)
+    work = np.empty(4)
     q0 = qb[0]
     for i in range(pbar.size):
         out[i] = u1_at(qb, c, e, cum3, kinks, zeta[i] * q0, pbar[i], gamma, ktab, glx, glw,
@@ -83,7 +84,7 @@ def _u1_kernel(qb, c, e, cum3, kinks, pbar, zeta, gamma, ktab, glx, glw, panel, 
 def _contact_pressure_kernel(qb, c, e, cum3, kinks, ubar, lnp_guess, gamma, ktab, glx, glw,
                              panel, out):
     """Solve ū(p) = u for ln p by safeguarded Newton (ū decreasing, dū/dln p = -I_g)."""
-    work = np.empty(3)
+    work = np.empty(4)
     q0 = qb[0]
     for i in range(ubar.size):
         target = ubar[i]
@@ -183,7 +184,8 @@ def percolation_pressure(psd, E_star, a_perc=0.5):
     return 2.0 * np.sqrt(G1) * sp_erfinv(a_perc)
 
 
-def _separation(psd, p, E_star, zeta, gamma, glx=None, glw=None, panel=PANEL):
+def _separation(psd, p, E_star, zeta, gamma, glx=None, glw=None, panel=PANEL, second=False):
+    """(ū, dū/d ln p[, d²ū/d(ln p)²]) [m] by direct quadrature (broadcast over p, E*, ζ)."""
     _check_psd(psd)
     p = check_positive("p", p, "[Pa]")
     E_star = check_positive("E_star", E_star, "[Pa]")
@@ -197,8 +199,11 @@ def _separation(psd, p, E_star, zeta, gamma, glx=None, glw=None, panel=PANEL):
         glx, glw = gauss_legendre()
     out = np.empty(pbar.size)
     dout = np.empty(pbar.size)
+    d2out = np.empty(pbar.size)
     _mean_separation_kernel(*_arrays(psd), pbar, z, gamma, k_table(), glx, glw, float(panel),
-                            out, dout)
+                            out, dout, d2out)
+    if second:
+        return out.reshape(shape), dout.reshape(shape), d2out.reshape(shape)
     return out.reshape(shape), dout.reshape(shape)
 
 

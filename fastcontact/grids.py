@@ -19,7 +19,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-__all__ = ["Grid", "hermite_uniform", "hermite_interval", "build_bucket_map", "locate_desc",
+__all__ = ["Grid", "hermite_uniform", "hermite_interval", "quintic_interval", "build_bucket_map", "locate_desc",
            "locate_asc"]
 
 LN10 = math.log(10.0)
@@ -59,6 +59,23 @@ def hermite_interval(x, x0, x1, y0, y1, d0, d1):
     u3 = u2 * u
     return ((2 * u3 - 3 * u2 + 1) * y0 + (u3 - 2 * u2 + u) * h * d0
             + (-2 * u3 + 3 * u2) * y1 + (u3 - u2) * h * d1)
+
+
+@njit(cache=True)
+def quintic_interval(x, x0, x1, y0, y1, d0, d1, s0, s1):
+    """Quintic Hermite on [x0, x1] with values y, first derivatives d and second s."""
+    h = x1 - x0
+    t = (x - x0) / h
+    t2 = t * t
+    t3 = t2 * t
+    t4 = t3 * t
+    t5 = t4 * t
+    return ((1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5) * y0
+            + (t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5) * h * d0
+            + 0.5 * (t2 - 3.0 * t3 + 3.0 * t4 - t5) * h * h * s0
+            + (10.0 * t3 - 15.0 * t4 + 6.0 * t5) * y1
+            + (-4.0 * t3 + 7.0 * t4 - 3.0 * t5) * h * d1
+            + 0.5 * (t3 - 2.0 * t4 + t5) * h * h * s1)
 
 
 @njit(cache=True)

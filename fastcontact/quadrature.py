@@ -18,6 +18,7 @@ For one lower limit ``a`` and reduced pressure ``P = p(ζ)/E*`` the kernel retur
     I_g = √π ∫ q²C w g(wP) dq                     = -dū/d ln p(ζ)
     J   = √π ∫ q²C w³ (F(wP) - g(wP)) dq
 
+and ``I_g' = dI_g/d ln P = √π ∫ q²C w s0 g'(s0) dq`` (so d²ū/d(ln p)² = -I_g'),
 with ``F(s) = (γ/2) E1(s²) + 3(1-γ) K(s)`` and ``g(s) = [γ + 3(1-γ) erf²(s)] e^{-s²}``
 (γ = 1 is the paper's A4; the Yang–Persson correction otherwise), so that (A3) becomes
 ``u1(ζ) = I_F + I_g + k(ζ) (A/A') J`` with ``k = (π/2) q0 (ζq0)³ C(ζq0)``.
@@ -151,11 +152,15 @@ def f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder):
 
 @njit(cache=True)
 def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, panel, out):
-    """(I_F, I_g, J) for lower limit ``a`` [1/m] and reduced pressure P into out[0:3] [m]."""
+    """(I_F, I_g, J, I_g') for lower limit ``a`` [1/m] and reduced pressure P into out[0:4] [m].
+
+    ``I_g' = √π ∫ q²C w s0 g'(s0) dq = dI_g/d ln P``, so ``d²ū/d(ln p)² = -I_g'``.
+    """
     kt0, kdt, kval, kder, rdt, rval, rder = ktab
     out[0] = 0.0
     out[1] = 0.0
     out[2] = 0.0
+    out[3] = 0.0
     q1 = qb[-1]
     if a >= q1 or P <= 0.0:
         return
@@ -190,6 +195,7 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
     sF = 0.0
     sg = 0.0
     sJ = 0.0
+    sG = 0.0
     ng = glx.size
     iq = ia  # segment of the current node (nodes increase monotonically)
     while t0 < tau_hi:
@@ -228,10 +234,18 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
             sF += wt * F
             sg += wt * g
             sJ += wt * w * w * (F - g)
+            x = s0 * s0
+            if gamma == 1.0:
+                sgp = -2.0 * x * g  # s g'(s) for g = e^{-s²}
+            else:
+                sgp = (3.0 * (1.0 - gamma) * 4.0 / SQRT_PI * s0 * math.erf(s0) * math.exp(-2.0 * x)
+                       - 2.0 * x * g)
+            sG += wt * sgp
         t0 = t1
     out[0] = SQRT_PI * sF
     out[1] = SQRT_PI * sg
     out[2] = SQRT_PI * sJ
+    out[3] = SQRT_PI * sG
 
 
 @njit(cache=True)

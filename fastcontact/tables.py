@@ -11,16 +11,20 @@ Columns (``Tables.data``), all dimensionless:
 p_over_E               p̄ = p_cont/E* (grid nodes)
 u_over_h               ū/h_rms                                                 (A4)
 dlnu_dlnp              d ln ū / d ln p̄ (exact, from the same quadrature)
+d2lnu_dlnp2            d² ln ū / d(ln p̄)² (exact)
 area_fraction          A(ζ1)/A0                                                (A1)
 sigma_<theory>         σ̄ for each requested theory (0 where percolated)        (23)
-dlnsigma_<theory>      d ln σ̄ / d ln p̄
+dlnsigma_<theory>      d ln σ̄ / d ln p̄ (critical junction: central differences of the exact
+                       quadrature; effective medium: local quartic through the nodes)
+d2lnsigma_<theory>     d² ln σ̄ / d(ln p̄)², likewise
 phi_<theory>           pressure flow factor φ_p = σ̄ (h_rms/ū)³               (Sec. 4)
 percolated_<theory>    True where the contact percolates (σ_eff = 0, fluid trapped)
 zeta_c, u1c_over_h     critical-junction magnification and u1(ζc)/h_rms      (A3)
 zeta, G_over_Estar2    G(ζ)/E*² on the log ζ grid (same number of rows)          (A2)
 =====================  ================================================================
 
-Interpolation: cubic Hermite in ln p̄ of ln ū and ln σ̄ with stored derivatives; in the one
+Interpolation: quintic Hermite in ln p̄ of ln ū (and of the inverse ln p̄(ln ū)) with exact
+first and second derivatives; likewise quintic Hermite of ln σ̄; in the one
 grid interval that contains a theory's percolation pressure, σ̄^(1/3) is interpolated
 linearly in ln p̄ to zero at the exact percolation pressure (closed form from A(ζ1)).
 Outside the grid nothing is extrapolated: Python methods raise, kernels return a flag.
@@ -41,12 +45,13 @@ from ._validate import check_positive, check_range
 from .conductivity import EMT_TOL, THEORIES, check_theory, sigma_bar
 from .contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
 from .atomic import atomic_path
-from .grids import Grid, build_bucket_map, hermite_interval, locate_asc, locate_desc
+from .grids import (Grid, build_bucket_map, locate_asc, locate_desc,
+                    quintic_interval)
 from .psd import PSD, psd_from_dict
 
 __all__ = ["Tables", "precompute", "DEFAULT_POINTS_PER_DECADE", "SCHEMA_VERSION"]
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 METADATA_KEY = b"fastcontact"
 #: default grid density in p̄ (chosen from bench/bench_tables.py, see bench/RESULTS.md)
 DEFAULT_POINTS_PER_DECADE = 8
@@ -71,13 +76,14 @@ REFERENCES = [
 
 UNITS = {
     "p_over_E": "1 (p_cont / E*)", "u_over_h": "1 (mean separation / h_rms)",
-    "dlnu_dlnp": "1", "area_fraction": "1 (A(zeta1)/A0)", "zeta_c": "1 (magnification)",
+    "dlnu_dlnp": "1", "d2lnu_dlnp2": "1", "area_fraction": "1 (A(zeta1)/A0)", "zeta_c": "1 (magnification)",
     "u1c_over_h": "1 (u1(zeta_c) / h_rms)", "zeta": "1 (magnification)",
     "G_over_Estar2": "1 (G(zeta) / E*^2)",
 }
 for _t in THEORIES:
     UNITS[f"sigma_{_t}"] = "1 (12 eta sigma_eff / h_rms^3)"
     UNITS[f"dlnsigma_{_t}"] = "1 (d ln sigma_bar / d ln p_bar)"
+    UNITS[f"d2lnsigma_{_t}"] = "1 (d2 ln sigma_bar / d ln p_bar2)"
     UNITS[f"phi_{_t}"] = "1 (pressure flow factor)"
     UNITS[f"percolated_{_t}"] = "bool"
 
@@ -88,37 +94,42 @@ class TableRangeError(ValueError):
 
 # =========================================================================== kernels
 # A theory's kernel tuple ``tab`` (Tables.kernel_data) is
-#   (lnp, lnu, dlnu, lnsig, dlnsig, lnp_perc, n_open, bp_lo, bp_dz, bp_idx, bu_lo, bu_dz, bu_idx)
-# lnp: ln p̄ at the nodes (increasing); lnu: ln(ū/h_rms) (decreasing); dlnu = d ln ū/d ln p̄;
+#   (lnp, lnu, dlnu, lnsig, dlnsig, lnp_perc, n_open, bp_lo, bp_dz, bp_idx, bu_lo, bu_dz, bu_idx,
+#    d2lnu, d2lnsig)
+# lnp: ln p̄ at the nodes (increasing); lnu: ln(ū/h_rms) (decreasing); dlnu = d ln ū/d ln p̄,
+# d2lnu = its derivative (exact, from the quadrature: ū(p̄) and its inverse are quintic Hermite);
 # lnsig, dlnsig: ln σ̄ and d ln σ̄/d ln p̄ (-inf / 0 where σ̄ = 0); lnp_perc: ln of the exact
 # percolation pressure (inf: none); n_open: number of leading nodes with σ̄ > 0;
 # bp_*, bu_*: O(1) bucket locators over ln p̄ and -ln ū.
 @njit(cache=True)
 def k_lnu_of_lnp(tab, lnp_q):
-    """ln(ū/h_rms) at ln p̄ (cubic Hermite); NaN outside the table."""
-    lnp, lnu, dlnu = tab[0], tab[1], tab[2]
+    """ln(ū/h_rms) at ln p̄ (quintic Hermite); NaN outside the table."""
+    lnp, lnu, dlnu, d2 = tab[0], tab[1], tab[2], tab[13]
     i = locate_asc(lnp_q, lnp, tab[7], tab[8], tab[9])
     if i < 0:
         return math.nan
-    return hermite_interval(lnp_q, lnp[i], lnp[i + 1], lnu[i], lnu[i + 1], dlnu[i], dlnu[i + 1])
+    return quintic_interval(lnp_q, lnp[i], lnp[i + 1], lnu[i], lnu[i + 1], dlnu[i], dlnu[i + 1],
+                            d2[i], d2[i + 1])
 
 
 @njit(cache=True)
 def k_lnp_of_lnu(tab, lnu_q):
-    """ln p̄ at ln(ū/h_rms) (inverse; cubic Hermite in ln ū); NaN outside the table."""
-    lnp, lnu, dlnu = tab[0], tab[1], tab[2]
+    """ln p̄ at ln(ū/h_rms) (inverse; quintic Hermite in ln ū); NaN outside the table."""
+    lnp, lnu, dlnu, d2 = tab[0], tab[1], tab[2], tab[13]
     i = locate_desc(lnu_q, lnu, tab[10], tab[11], tab[12])
     if i < 0:
         return math.nan
-    return hermite_interval(lnu_q, lnu[i], lnu[i + 1], lnp[i], lnp[i + 1], 1.0 / dlnu[i],
-                            1.0 / dlnu[i + 1])
+    a0 = dlnu[i]
+    a1 = dlnu[i + 1]
+    return quintic_interval(lnu_q, lnu[i], lnu[i + 1], lnp[i], lnp[i + 1], 1.0 / a0, 1.0 / a1,
+                            -d2[i] / a0 ** 3, -d2[i + 1] / a1 ** 3)
 
 
 @njit(cache=True)
 def k_sigma_of_lnp(tab, lnp_q):
     """σ̄ = 12ησ_eff/h_rms³ at ln p̄; exactly 0 at and beyond percolation; NaN outside.
 
-    Hermite of ln σ̄ between open nodes; between the last open node and the exact
+    Quintic Hermite of ln σ̄ between open nodes; between the last open node and the exact
     percolation pressure σ̄^(1/3) falls linearly in ln p̄ to 0 (σ̄ < 1e-30 there).
     """
     lnp, lnsig, dlnsig, lnp_perc, n_open = tab[0], tab[3], tab[4], tab[5], tab[6]
@@ -128,8 +139,9 @@ def k_sigma_of_lnp(tab, lnp_q):
     if lnp_q >= lnp_perc:
         return 0.0
     if i + 1 < n_open:
-        return math.exp(hermite_interval(lnp_q, lnp[i], lnp[i + 1], lnsig[i], lnsig[i + 1],
-                                         dlnsig[i], dlnsig[i + 1]))
+        d2 = tab[14]
+        return math.exp(quintic_interval(lnp_q, lnp[i], lnp[i + 1], lnsig[i], lnsig[i + 1],
+                                         dlnsig[i], dlnsig[i + 1], d2[i], d2[i + 1]))
     j = n_open - 1
     if j < 0 or lnp_perc == math.inf:
         return 0.0
@@ -227,6 +239,7 @@ class Tables:
         self._ln_p = np.ascontiguousarray(np.log(data["p_over_E"]))
         self._lnu = np.ascontiguousarray(np.log(data["u_over_h"]))
         self._dlnu = np.ascontiguousarray(data["dlnu_dlnp"])
+        self._d2lnu = np.ascontiguousarray(data["d2lnu_dlnp2"])
         self._bp = build_bucket_map(self._ln_p, ascending=True)
         self._bu = build_bucket_map(self._lnu)
         self._kernel_cache = {}
@@ -279,7 +292,8 @@ class Tables:
             self._kernel_cache[theory] = (
                 self._ln_p, self._lnu, self._dlnu, lnsig,
                 np.ascontiguousarray(self.data[f"dlnsigma_{theory}"], dtype=np.float64),
-                float(lnp_perc), n_open, *self._bp, *self._bu)
+                float(lnp_perc), n_open, *self._bp, *self._bu, self._d2lnu,
+                np.ascontiguousarray(self.data[f"d2lnsigma_{theory}"], dtype=np.float64))
         return self._kernel_cache[theory]
 
     # ------------------------------------------------------------------ range checks
@@ -439,10 +453,11 @@ class Tables:
 
 # =========================================================================== precompute
 #: relative interpolation tolerances the adaptive refinement enforces at interval midpoints
-TOLERANCE = {"u": 5e-8, "p_of_u": 5e-7, "sigma": 5e-7}
+TOLERANCE = {"u": 5e-9, "p_of_u": 5e-9, "slope": 5e-8, "sigma": 2e-7}
 #: σ̄ below this is "at percolation" for the refinement (not resolved further; time scales
 #: there exceed 1e20 τ-units)
 SIGMA_FLOOR = 1e-24
+BOUNDARY_FACTOR = 1e3
 MAX_NODES = 6000
 MIN_DLNP = 1e-6
 
@@ -461,34 +476,38 @@ def default_grid(surface: PSD, gamma=1.0, points_per_decade=DEFAULT_POINTS_PER_D
 def _exact(psd, pbar, theories, sig_opts):
     """Exact columns at reduced pressures pbar (direct quadrature)."""
     pbar = np.ascontiguousarray(pbar, dtype=np.float64)
-    u, du = _separation(psd, pbar, 1.0, 1.0, sig_opts["gamma"])
+    u, du, d2u = _separation(psd, pbar, 1.0, 1.0, sig_opts["gamma"], second=True)
     h = psd.h_rms
-    out = {"u": u / h, "dlnu": du / u}
+    out = {"u": u / h, "dlnu": du / u, "d2lnu": d2u / u - (du / u) ** 2}
     for th in theories:
         sb, perc, extra = sigma_bar(psd, pbar, th, **sig_opts)
         out[f"sigma_{th}"] = sb
         out[f"percolated_{th}"] = perc
         if th == "average":
             out[f"dlnsigma_{th}"] = 3.0 * out["dlnu"]
+            out[f"d2lnsigma_{th}"] = 3.0 * out["d2lnu"]
         elif th == "critical_junction":
             eps = 1e-4
             up, _, _ = sigma_bar(psd, pbar * math.exp(eps), th, **sig_opts)
             um, _, _ = sigma_bar(psd, pbar * math.exp(-eps), th, **sig_opts)
             with np.errstate(divide="ignore", invalid="ignore"):
                 d = (np.log(up) - np.log(um)) / (2 * eps)
+                d2 = (np.log(up) - 2 * np.log(sb) + np.log(um)) / eps ** 2
             out[f"dlnsigma_{th}"] = np.where(np.isfinite(d) & (sb > 0), d, 0.0)
+            out[f"d2lnsigma_{th}"] = np.where(np.isfinite(d2) & (sb > 0), d2, 0.0)
             out["zeta_c"] = extra["zeta_c"]
             out["u1c_over_h"] = extra["u1c"]
     return out
 
 
 def _node_derivative(x, y, ok):
-    """d y/d x at the open nodes from the degree-4 polynomial through the 5 nearest open nodes."""
+    """(dy/dx, d²y/dx²) at the open nodes from the degree-4 polynomial through the 5 nearest."""
     d = np.zeros_like(y)
+    d2 = np.zeros_like(y)
     idx = np.flatnonzero(ok)
     m = idx.size
-    if m < 2:
-        return d
+    if m < 3:
+        return d, d2
     w = min(5, m)
     k = np.arange(m)
     lo = np.clip(k - w // 2, 0, m - w)
@@ -497,26 +516,43 @@ def _node_derivative(x, y, ok):
     V = dx[:, :, None] ** np.arange(w)[None, None, :]          # Vandermonde (m, w, w)
     coef = np.linalg.solve(V, y[sten][:, :, None])[:, :, 0]
     d[idx] = coef[:, 1]
-    return d
+    d2[idx] = 2.0 * coef[:, 2]
+    return d, d2
 
 
-def _hermite_np(x, x0, x1, y0, y1, d0, d1):
+def _quintic_np(x, x0, x1, y0, y1, d0, d1, s0, s1, deriv=False):
     h = x1 - x0
-    u = (x - x0) / h
-    return ((2 * u ** 3 - 3 * u ** 2 + 1) * y0 + (u ** 3 - 2 * u ** 2 + u) * h * d0
-            + (-2 * u ** 3 + 3 * u ** 2) * y1 + (u ** 3 - u ** 2) * h * d1)
+    t = (x - x0) / h
+    if deriv:
+        return ((-30 * t ** 2 + 60 * t ** 3 - 30 * t ** 4) * y0 / h
+                + (1 - 18 * t ** 2 + 32 * t ** 3 - 15 * t ** 4) * d0
+                + 0.5 * (2 * t - 9 * t ** 2 + 12 * t ** 3 - 5 * t ** 4) * h * s0
+                + (30 * t ** 2 - 60 * t ** 3 + 30 * t ** 4) * y1 / h
+                + (-12 * t ** 2 + 28 * t ** 3 - 15 * t ** 4) * d1
+                + 0.5 * (3 * t ** 2 - 8 * t ** 3 + 5 * t ** 4) * h * s1)
+    return ((1 - 10 * t ** 3 + 15 * t ** 4 - 6 * t ** 5) * y0
+            + (t - 6 * t ** 3 + 8 * t ** 4 - 3 * t ** 5) * h * d0
+            + 0.5 * (t ** 2 - 3 * t ** 3 + 3 * t ** 4 - t ** 5) * h * h * s0
+            + (10 * t ** 3 - 15 * t ** 4 + 6 * t ** 5) * y1
+            + (-4 * t ** 3 + 7 * t ** 4 - 3 * t ** 5) * h * d1
+            + 0.5 * (t ** 3 - 2 * t ** 4 + t ** 5) * h * h * s1)
 
 
 def _interval_errors(lnp, cols, mids, theories):
-    """Relative midpoint errors of each column's Hermite interpolant, per interval."""
+    """Relative midpoint errors of each column's interpolant, per interval."""
     x0, x1 = lnp[:-1], lnp[1:]
     xm = 0.5 * (x0 + x1)
     lnu = np.log(cols["u"])
     du = cols["dlnu"]
-    est = _hermite_np(xm, x0, x1, lnu[:-1], lnu[1:], du[:-1], du[1:])
+    d2 = cols["d2lnu"]
+    args = (x0, x1, lnu[:-1], lnu[1:], du[:-1], du[1:], d2[:-1], d2[1:])
+    est = _quintic_np(xm, *args)
     err = {"u": np.abs(np.expm1(est - np.log(mids["u"])))}
+    slope = _quintic_np(xm, *args, deriv=True)
+    err["slope"] = np.abs(slope / mids["dlnu"] - 1.0)
     lnum = np.log(mids["u"])
-    est_p = _hermite_np(lnum, lnu[:-1], lnu[1:], x0, x1, 1 / du[:-1], 1 / du[1:])
+    est_p = _quintic_np(lnum, lnu[:-1], lnu[1:], x0, x1, 1 / du[:-1], 1 / du[1:],
+                        -d2[:-1] / du[:-1] ** 3, -d2[1:] / du[1:] ** 3)
     err["p_of_u"] = np.abs(np.expm1(est_p - xm))
     for th in theories:
         s = cols[f"sigma_{th}"]
@@ -525,8 +561,9 @@ def _interval_errors(lnp, cols, mids, theories):
         e = np.zeros(xm.size)
         if np.any(ok):
             ds = cols[f"dlnsigma_{th}"]
-            est_s = _hermite_np(xm[ok], x0[ok], x1[ok], np.log(s[:-1][ok]), np.log(s[1:][ok]),
-                                ds[:-1][ok], ds[1:][ok])
+            d2s = cols[f"d2lnsigma_{th}"]
+            est_s = _quintic_np(xm[ok], x0[ok], x1[ok], np.log(s[:-1][ok]), np.log(s[1:][ok]),
+                                ds[:-1][ok], ds[1:][ok], d2s[:-1][ok], d2s[1:][ok])
             e[ok] = np.abs(np.expm1(est_s - np.log(sm[ok])))
         err[f"sigma_{th}"] = e
     return err
@@ -539,7 +576,8 @@ def precompute(psd, theories=("average", "critical_junction", "emt"), gamma=1.0,
 
     The base grid (uniform in ln p̄) is refined adaptively: every interval whose Hermite
     interpolant misses the exact quadrature at its midpoint by more than ``tolerance``
-    (relative; ū, p_cont(ū), and each σ̄ above SIGMA_FLOOR) is split, until all pass.
+    (relative; ū, p_cont(ū), the slope d ln ū/d ln p̄ that sets squeeze-out rates near
+    equilibrium, and each σ̄ above SIGMA_FLOOR) is split, until all pass.
     The midpoint errors of the final grid are recorded in ``info["interpolation_error"]``.
 
     Parameters
@@ -553,7 +591,7 @@ def precompute(psd, theories=("average", "critical_junction", "emt"), gamma=1.0,
     emt_tol : float      relative accuracy of the adaptive effective-medium integral
     emt_almqvist : bool  Almqvist-broadened separation distribution in the effective medium
     points_per_decade : int, optional  density of the default base grid
-    tolerance : dict, optional  overrides of TOLERANCE ("u", "p_of_u", "sigma")
+    tolerance : dict, optional  overrides of TOLERANCE ("u", "p_of_u", "slope", "sigma")
     refine : bool        False: keep the base grid (errors are still measured and recorded)
     """
     t_start = time.perf_counter()
@@ -582,14 +620,16 @@ def precompute(psd, theories=("average", "critical_junction", "emt"), gamma=1.0,
             s = cols["sigma_emt"]
             ok = s > SIGMA_FLOOR
             with np.errstate(divide="ignore"):
-                cols["dlnsigma_emt"] = _node_derivative(lnp, np.where(ok, np.log(np.where(ok, s, 1)), 0), ok)
+                cols["dlnsigma_emt"], cols["d2lnsigma_emt"] = _node_derivative(
+                    lnp, np.where(ok, np.log(np.where(ok, s, 1)), 0), ok)
         xm = 0.5 * (lnp[:-1] + lnp[1:])
         need = np.array([x not in mid_cache for x in xm])
         if np.any(need):
             new = _exact(psd, np.exp(xm[need]), theories, sig_opts)
             for k, x in enumerate(xm[need]):
                 mid_cache[x] = {c: v[k] for c, v in new.items()}
-        mids = {c: np.array([mid_cache[x][c] for x in xm]) for c in cols if c != "dlnsigma_emt"}
+        mids = {c: np.array([mid_cache[x][c] for x in xm]) for c in cols
+                if c not in ("dlnsigma_emt", "d2lnsigma_emt")}
         if not np.all(np.diff(np.log(np.concatenate(([cols["u"][0]], mids["u"])))) < 0) \
                 or not np.all(np.diff(cols["u"]) < 0):
             raise ValueError(f"grid = {tuple(grid)!r} is invalid for this surface: ū(p) is not "
@@ -598,6 +638,14 @@ def precompute(psd, theories=("average", "critical_junction", "emt"), gamma=1.0,
         bad = np.zeros(xm.size, dtype=bool)
         for c, e in errs.items():
             bad |= e > tol["sigma" if c.startswith("sigma") else c]
+        # intervals straddling the σ̄ floor (the super-exponential collapse of u1(ζc) before
+        # percolation) are bisected until their open end is within BOUNDARY_FACTOR of it
+        for th in theories:
+            sg = cols[f"sigma_{th}"]
+            above = sg > SIGMA_FLOOR
+            straddle = above[:-1] != above[1:]
+            open_end = np.maximum(sg[:-1], sg[1:])
+            bad |= straddle & (open_end > BOUNDARY_FACTOR * SIGMA_FLOOR)
         bad &= (lnp[1:] - lnp[:-1]) > 2 * MIN_DLNP
         if not refine or not np.any(bad) or lnp.size + bad.sum() > MAX_NODES:
             break
@@ -609,7 +657,8 @@ def precompute(psd, theories=("average", "critical_junction", "emt"), gamma=1.0,
             extra = mids[c][bad] if c in mids else np.zeros(int(bad.sum()))
             cols[c] = np.concatenate((cols[c], extra))[order]
     pbar = np.exp(lnp)
-    data = {"p_over_E": pbar, "u_over_h": cols["u"], "dlnu_dlnp": cols["dlnu"]}
+    data = {"p_over_E": pbar, "u_over_h": cols["u"], "dlnu_dlnp": cols["dlnu"],
+            "d2lnu_dlnp2": cols["d2lnu"]}
     G1 = 0.25 * math.pi * psd.cum3[-1]
     from scipy.special import erf
     data["area_fraction"] = erf(pbar / (2.0 * math.sqrt(G1)))
@@ -617,6 +666,7 @@ def precompute(psd, theories=("average", "critical_junction", "emt"), gamma=1.0,
     for th in theories:
         data[f"sigma_{th}"] = cols[f"sigma_{th}"]
         data[f"dlnsigma_{th}"] = np.where(cols[f"sigma_{th}"] > 0, cols[f"dlnsigma_{th}"], 0.0)
+        data[f"d2lnsigma_{th}"] = np.where(cols[f"sigma_{th}"] > 0, cols[f"d2lnsigma_{th}"], 0.0)
         data[f"phi_{th}"] = cols[f"sigma_{th}"] / cols["u"] ** 3
         data[f"percolated_{th}"] = cols[f"percolated_{th}"].astype(bool)
         if th == "critical_junction":
