@@ -68,12 +68,13 @@ Two engines, one pass over all cases each (``@njit(parallel=True)``, prange):
     costs one O(1) interval lookup and one Horner polynomial per column. The π0-dependence
     of the time lives in 1/(π0 - π_c), so a generic 1-D primitive cannot carry it; but the
     targets (ratios, Δu) and the default start are fixed per call, so each target's time is
-    a function of π0 alone. Rows the spline cannot serve (user ``u_start``, trapped rows)
-    fall back to the quad engine inside the same kernel. Structures are built lazily and
-    cached per (tables, theory, target).
+    a function of π0 alone. Rows the spline cannot serve (user ``u_start``, trapped rows,
+    p0 within one node of the trap) fall back to the quad engine inside the same kernel,
+    and so do all rows when ``times`` is given. Structures are built lazily and cached per
+    (tables, theory, target): ~0.3 s per target on 2 cores, ~2000 nodes.
 
 ``u_at_<t>`` columns and :func:`squeeze_history` invert t̃(v) per case by safeguarded
-Newton in w with incremental Gauss–Legendre integration (µs per time point).
+Newton in w with incremental Gauss–Legendre integration (tens of µs per time point).
 """
 from __future__ import annotations
 
@@ -98,7 +99,8 @@ DEFAULT_P_START = 1e-3
 #: default per-case Gauss–Legendre order and panel width in w = ln(v - v∞) (method="quad")
 QUAD_ORDER = 10
 QUAD_WIDTH = 1.0
-#: order / width used to compute the spline nodes of the fast path (converged to ~1e-13)
+#: order / width used to compute the spline nodes of the fast path (GL6, width 1 already
+#: agrees with the direct reference to ~1e-9; see bench/squeeze_results.md)
 NODE_ORDER = 20
 NODE_WIDTH = 0.25
 #: spacing of the fast-path spline nodes in ξ = ln π0 - ln σ̄(π0) (see bench/bench_squeeze.py)
@@ -107,8 +109,8 @@ FAST_DXI = 0.05
 TAIL_EXTENT = 40.0
 
 # par vector layout
-P_XMIN, P_XMAX, P_VTOP, P_U0, P_C, P_XTRAP, P_VEXT, P_XPERC, P_VTRAP, P_LNPST = range(10)
-N_PAR = 10
+P_XMIN, P_XMAX, P_VTOP, P_U0, P_C, P_XTRAP, P_VEXT, P_XPERC, P_VTRAP, P_LNPST, P_D = range(11)
+N_PAR = 11
 
 # status codes
 ST_OK, ST_TRAPPED, ST_OUT = 0, 1, 2
@@ -120,7 +122,8 @@ def _state(tab, par, v):
     """(ln π_c, σ̄) at separation v [h_rms]: tables, or the analytic tail above v_top."""
     v_top = par[P_VTOP]
     if v > v_top:
-        return par[P_XMIN] - (v - v_top) / par[P_U0], v * (v * v - par[P_C])
+        y = v + par[P_D]
+        return par[P_XMIN] - (v - v_top) / par[P_U0], y * (y * y - par[P_C])
     lnp = k_lnp_of_lnu(tab, math.log(v))
     if lnp != lnp:
         return lnp, math.nan
@@ -223,7 +226,7 @@ def _time(tab, par, x0, vb, v_lo, v_hi, glx, glw, width):
     v_ext = par[P_VEXT]
     if v_hi > v_ext:
         a = v_lo if v_lo > v_ext else v_ext
-        total += _tail_int(par[P_C], a, v_hi)
+        total += _tail_int(par[P_C], a + par[P_D], v_hi + par[P_D])
         if v_lo >= v_ext:
             return total
         v_hi = v_ext
@@ -290,168 +293,158 @@ def _v_at_time(tab, par, x0, vb, v_floor, vs, t_prev, w_prev, t_target, glx, glw
 
 
 @njit(cache=True)
-def _case(tab, par, x0, vs_in, ratios, dvs, times_t, glx, glw, width, row, t_out, u_out,
-          scal):
-    """Everything for one case in reduced units. times_t: requested times in t̃ units
-    (ascending). Writes t_out[row, :] (t̃ per target: t*, ratios..., Δu...) and
-    u_out[row, :] (v at each time) and scal[row, :] = (v∞, v_start, status, v_trap, π_trap/π0,
-    S, t̃_trap). Returns nothing."""
-    nt = t_out.shape[1]
+def _case(tab, par, x0, vs_in, ratios, dvs, times_s, tau, h, glx, glw, width, i, T, U, uinf,
+          ustart, trelax, utrap, ttrap, flf, status):
+    """Everything for one case, written in SI to column i of the outputs.
+
+    Reduced internally (v in h_rms, t̃ in τ0 = tau); T[k, i]: time to target k (k = 0: t*,
+    then ``ratios``, then ``dvs`` in h_rms); U[k, i]: ū at ``times_s[k]`` (ascending)."""
+    nt = T.shape[0]
+    nu = U.shape[0]
     if not (par[P_XMIN] <= x0 <= par[P_XMAX]):
         for k in range(nt):
-            t_out[row, k] = math.nan
-        for k in range(u_out.shape[1]):
-            u_out[row, k] = math.nan
-        scal[row, 0] = math.nan
-        scal[row, 1] = vs_in
-        scal[row, 2] = ST_OUT
-        scal[row, 3] = math.nan
-        scal[row, 4] = math.nan
-        scal[row, 5] = math.nan
-        scal[row, 6] = math.nan
+            T[k, i] = math.nan
+        for k in range(nu):
+            U[k, i] = math.nan
+        uinf[i] = math.nan
+        ustart[i] = vs_in * h
+        trelax[i] = math.nan
+        utrap[i] = math.nan
+        ttrap[i] = math.nan
+        flf[i] = math.nan
+        status[i] = ST_OUT
         return
     vinf = math.exp(_lnv_of_lnp(tab, par, x0))
     vs = vs_in
-    if vs != vs:  # default start
+    if vs != vs:  # default start: p_cont(v_start) = DEFAULT_P_START p0
         vs = math.exp(_lnv_of_lnp(tab, par, x0 + par[P_LNPST]))
     trapped = x0 >= par[P_XTRAP]
-    lnp_s, sig_s = _state(tab, par, vinf)
-    S = math.nan
-    if not trapped:
-        # relaxation time S = v∞ |dlnv/dlnπ| / σ̄(π0), slope from the consistent inverse
-        S = vinf * _dlnv_dlnp(tab, par, x0) / k_sigma_of_lnp(tab, x0)
-    scal[row, 0] = vinf
-    scal[row, 1] = vs
-    scal[row, 5] = S
+    uinf[i] = vinf * h
+    ustart[i] = vs * h
     if trapped:
-        vtrap = par[P_VTRAP]
-        scal[row, 2] = ST_TRAPPED
-        scal[row, 3] = vtrap
-        scal[row, 4] = math.exp(par[P_XTRAP] - x0)
-        vb = vtrap
-        vfloor = vtrap
+        vb = par[P_VTRAP]
+        status[i] = ST_TRAPPED
+        utrap[i] = vb * h
+        flf[i] = -math.expm1(par[P_XTRAP] - x0)
+        trelax[i] = math.nan
     else:
-        scal[row, 2] = ST_OK
-        scal[row, 3] = math.nan
-        scal[row, 4] = 1.0
         vb = vinf
-        vfloor = vinf
-    # targets
+        status[i] = ST_OK
+        utrap[i] = math.nan
+        flf[i] = 0.0
+        trelax[i] = tau * vinf * _dlnv_dlnp(tab, par, x0) / k_sigma_of_lnp(tab, x0)
+    # targets: one downward pass from the start, segment by segment (sorted by separation)
     nr = ratios.size
+    vts = np.empty(nt)
     for k in range(nt):
         if k == 0:
-            vt = 1.01 * vinf
+            vts[k] = 1.01 * vinf
         elif k <= nr:
-            vt = ratios[k - 1] * vinf
+            vts[k] = ratios[k - 1] * vinf
         else:
-            vt = vinf + dvs[k - 1 - nr]
+            vts[k] = vinf + dvs[k - 1 - nr]
+    order = np.argsort(-vts)
+    v_cur = vs
+    t_cur = 0.0
+    for kk in range(nt):
+        k = order[kk]
+        vt = vts[k]
         if vt >= vs:
-            t_out[row, k] = 0.0
+            T[k, i] = 0.0
         elif trapped and (vt <= vb or vs <= vb):
-            t_out[row, k] = math.inf
+            T[k, i] = math.inf
         else:
-            t_out[row, k] = _time(tab, par, x0, vb, vt, vs, glx, glw, width)
-    # trap time (finite: σ̄ >= σ_trap down to v_trap) — integrated in ln(v - v_trap)
+            if vt < v_cur:
+                t_cur += _time(tab, par, x0, vb, vt, v_cur, glx, glw, width)
+                v_cur = vt
+            T[k, i] = tau * t_cur
+    # trap time: finite (σ̄ >= σ_trap down to v_trap); below w_lo = ln(v_trap) - 30 the
+    # integrand is e^w × const (relative change O(1e-13)), added in closed form
+    t_trap = math.inf
     if trapped:
         if vs <= vb:
-            scal[row, 6] = 0.0
+            t_trap = 0.0
         else:
-            # below w_lo the integrand is e^w/(σ_trap (1 - π_trap/π0)) to O(e^w/Δv_s)
-            w_lo = math.log(vb) - 40.0
-            g0 = _dtdw(tab, par, x0, vb, w_lo)
-            scal[row, 6] = g0 + _time(tab, par, x0, vb, vb + math.exp(w_lo), vs, glx, glw,
-                                      width)
-    else:
-        scal[row, 6] = math.inf
-    # separation at requested times
+            w_lo = math.log(vb) - 30.0
+            t_trap = (_dtdw(tab, par, x0, vb, w_lo)
+                      + _time(tab, par, x0, vb, vb + math.exp(w_lo), vs, glx, glw, width))
+    ttrap[i] = tau * t_trap
     tp = 0.0
-    if vs > vb:
-        wp = math.log(vs - vb)
-    else:
-        wp = -math.inf
-    for k in range(times_t.size):
-        tk = times_t[k]
+    wp = math.log(vs - vb) if vs > vb else -math.inf
+    for k in range(nu):
+        tk = times_s[k] / tau
         if vs <= vb:
-            u_out[row, k] = vs
-            continue
-        if tk == math.inf:
-            u_out[row, k] = vfloor
-            continue
-        if trapped and tk >= scal[row, 6]:
-            u_out[row, k] = vfloor
-            continue
-        v, tp, wp = _v_at_time(tab, par, x0, vb, vfloor, vs, tp, wp, tk, glx, glw, width)
-        u_out[row, k] = v
+            U[k, i] = vs * h
+        elif tk == math.inf or (trapped and tk >= t_trap):
+            U[k, i] = vb * h
+        else:
+            v, tp, wp = _v_at_time(tab, par, x0, vb, vb, vs, tp, wp, tk, glx, glw, width)
+            U[k, i] = v * h
 
 
 @njit(parallel=True, cache=True)
-def _quad_kernel(tab, par, x0a, vsa, tau0a, ratios, dvs, times_s, glx, glw, width, t_out,
-                 u_out, scal):
+def _quad_kernel(tab, par, p0, E, R, eta, us, h, ratios, dvs, times_s, glx, glw, width, T, U,
+                 uinf, ustart, trelax, utrap, ttrap, flf, tau0, status):
     """method="quad": every case by per-case quadrature (one prange pass)."""
-    n = x0a.size
-    for i in prange(n):
-        tt = np.empty(times_s.size)
-        for k in range(times_s.size):
-            tt[k] = times_s[k] / tau0a[i]
-        _case(tab, par, x0a[i], vsa[i], ratios, dvs, tt, glx, glw, width, i, t_out, u_out,
-              scal)
-        for k in range(t_out.shape[1]):
-            t_out[i, k] *= tau0a[i]
-        scal[i, 6] *= tau0a[i]
+    for i in prange(p0.size):
+        tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
+        tau0[i] = tau
+        _case(tab, par, math.log(p0[i] / E[i]), us[i] / h, ratios, dvs, times_s, tau, h, glx,
+              glw, width, i, T, U, uinf, ustart, trelax, utrap, ttrap, flf, status)
 
 
 @njit(cache=True)
-def _horner(coef, j, d):
-    return ((coef[0, j] * d + coef[1, j]) * d + coef[2, j]) * d + coef[3, j]
+def _horner(C, j, s, d):
+    """Spline s of the packed coefficients C[interval, spline, power] at offset d."""
+    return ((C[j, s, 0] * d + C[j, s, 1]) * d + C[j, s, 2]) * d + C[j, s, 3]
 
 
 @njit(parallel=True, cache=True)
-def _fast_kernel(tab, par, x0a, vsa, tau0a, ratios, dvs, times_s, glx, glw, width, xn, blo,
-                 bdz, bidx, c_lnS, c_lnv, c_lnvs, c_T, t_out, u_out, scal):
-    """method="fast": default-start, non-trapped, in-table rows from the splines; all other
-    rows (user u_start, trapped, out of table, u_at columns) by the quad engine."""
-    n = x0a.size
-    nt = t_out.shape[1]
-    ntimes = times_s.size
+def _fast_kernel(tab, par, p0, E, R, eta, us, h, ratios, dvs, times_s, glx, glw, width, xn, blo,
+                 bdz, bidx, C, T, U, uinf, ustart, trelax, utrap, ttrap, flf, tau0, status):
+    """method="fast": default-start, non-trapped, in-table rows from the splines (C packs,
+    per interval, ln S, ln v∞, ln v_start and t̃/S of every target: one or two cache lines
+    per case); all other rows (user u_start, trapped, out of table, or any u_at column) by
+    the quad engine."""
+    nt = T.shape[0]
     x_lo = xn[0]
     x_hi = xn[xn.size - 1]
-    for i in prange(n):
-        x0 = x0a[i]
-        if vsa[i] != vsa[i] and x_lo <= x0 <= x_hi and x0 < par[P_XTRAP] and ntimes == 0:
+    use_spline = times_s.size == 0
+    for i in prange(p0.size):
+        x0 = math.log(p0[i] / E[i])
+        tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
+        tau0[i] = tau
+        if use_spline and us[i] != us[i] and x_lo <= x0 <= x_hi:
             j = locate_asc(x0, xn, blo, bdz, bidx)
             d = x0 - xn[j]
-            S = math.exp(_horner(c_lnS, j, d))
-            vinf = math.exp(_horner(c_lnv, j, d))
-            vs = math.exp(_horner(c_lnvs, j, d))
-            tau = tau0a[i]
+            tS = tau * math.exp(_horner(C, j, 0, d))
             for k in range(nt):
-                t_out[i, k] = tau * S * _horner(c_T[k], j, d)
-            scal[i, 0] = vinf
-            scal[i, 1] = vs
-            scal[i, 2] = ST_OK
-            scal[i, 3] = math.nan
-            scal[i, 4] = 1.0
-            scal[i, 5] = S
-            scal[i, 6] = math.inf
+                T[k, i] = tS * _horner(C, j, 3 + k, d)
+            uinf[i] = h * math.exp(_horner(C, j, 1, d))
+            ustart[i] = h * math.exp(_horner(C, j, 2, d))
+            trelax[i] = tS
+            utrap[i] = math.nan
+            ttrap[i] = math.inf
+            flf[i] = 0.0
+            status[i] = ST_OK
         else:
-            tt = np.empty(ntimes)
-            for k in range(ntimes):
-                tt[k] = times_s[k] / tau0a[i]
-            _case(tab, par, x0, vsa[i], ratios, dvs, tt, glx, glw, width, i, t_out, u_out,
-                  scal)
-            for k in range(nt):
-                t_out[i, k] *= tau0a[i]
-            scal[i, 6] *= tau0a[i]
+            _case(tab, par, x0, us[i] / h, ratios, dvs, times_s, tau, h, glx, glw, width, i, T,
+                  U, uinf, ustart, trelax, utrap, ttrap, flf, status)
 
 
 @njit(parallel=True, cache=True)
-def _node_kernel(tab, par, xs, ratios, dvs, glx, glw, width, t_out, scal):
-    """Spline node values: the quad engine at high order, default start, no time columns."""
+def _node_kernel(tab, par, xs, ratios, dvs, glx, glw, width, T, uinf, ustart, trelax):
+    """Spline node values (reduced units): the quad engine at high order, default start."""
+    n = xs.size
     tt = np.empty(0)
-    u_dummy = np.empty((xs.size, 0))
-    for i in prange(xs.size):
-        _case(tab, par, xs[i], math.nan, ratios, dvs, tt, glx, glw, width, i, t_out, u_dummy,
-              scal)
+    U = np.empty((0, n))
+    utrap = np.empty(n)
+    ttrap = np.empty(n)
+    flf = np.empty(n)
+    status = np.empty(n, dtype=np.int8)
+    for i in prange(n):
+        _case(tab, par, xs[i], math.nan, ratios, dvs, tt, 1.0, 1.0, glx, glw, width, i, T, U,
+              uinf, ustart, trelax, utrap, ttrap, flf, status)
 
 
 # =========================================================================== model setup
@@ -483,8 +476,23 @@ class SqueezeModel:
         ev_u = _ev_lnu(tab, np.array([x_min, x_min + 1e-4]))
         v_top = math.exp(ev_u[0])
         u0 = -(math.exp(ev_u[1]) - v_top) / 1e-4          # -dv/dln p at the top
-        sig_top = float(_ev_sig(tab, np.array([x_min]))[0])
-        c = v_top ** 2 - sig_top / v_top
+        # tail σ̄ = y³ - c y, y = v + d: value and slope matched to the table at the top
+        hx = 1e-4
+        sg = _ev_sig(tab, np.array([x_min, x_min + hx, x_min + 2 * hx]))
+        sig_top = float(sg[0])
+        dlns_dx = (-3.0 * math.log(sg[0]) + 4.0 * math.log(sg[1]) - math.log(sg[2])) / (2 * hx)
+        s1 = sig_top * dlns_dx / (-u0)                    # dσ̄/dv at the top
+        y = v_top
+        for _ in range(100):                              # 2y³ - s1 y + σ̄ = 0 near v_top
+            f = 2 * y ** 3 - s1 * y + sig_top
+            dy = f / (6 * y * y - s1)
+            y -= dy
+            if abs(dy) < 1e-15 * y:
+                break
+        d = y - v_top
+        c = 3 * y * y - s1
+        if not (abs(d) < 0.1 * v_top and abs(c) < 0.1 * y * y):   # fall back: value only
+            d, c = 0.0, v_top ** 2 - sig_top / v_top
         perc = tables.info["percolation_p_over_E"][theory]
         x_perc = math.log(perc) if np.isfinite(perc) else math.inf
         x_trap = self._find_trap(tab, x_min, x_max, x_perc)
@@ -492,12 +500,13 @@ class SqueezeModel:
         par[P_XMIN], par[P_XMAX], par[P_VTOP], par[P_U0], par[P_C] = x_min, x_max, v_top, u0, c
         par[P_XTRAP], par[P_VEXT], par[P_XPERC] = x_trap, v_top + TAIL_EXTENT * u0, x_perc
         par[P_LNPST] = math.log(DEFAULT_P_START)
+        par[P_D] = d
         par[P_VTRAP] = math.nan
         if np.isfinite(x_trap):
             par[P_VTRAP] = math.exp(_ev_lnv_consistent(tab, par, np.array([x_trap]))[0])
         self.par = par
         self.x_min, self.x_max, self.x_trap, self.x_perc = x_min, x_max, x_trap, x_perc
-        self.v_top, self.u0, self.c_tail = v_top, u0, c
+        self.v_top, self.u0, self.c_tail, self.d_tail = v_top, u0, c, d
         self._fast = None
         self._targets = {}
         self._lock = threading.Lock()
@@ -505,6 +514,8 @@ class SqueezeModel:
 
     def _find_trap(self, tab, x_min, x_max, x_perc):
         """ln π where σ̄ falls to sigma_trap (bisection on the tables' σ̄); inf if never."""
+        if not np.isfinite(x_perc):
+            return math.inf  # "average": σ̄ = v³ exactly, no percolation, nothing to floor
         hi = min(x_perc, x_max)
         s_hi = float(_ev_sig(tab, np.array([hi]))[0])
         if s_hi >= self.sigma_trap:
@@ -537,27 +548,38 @@ class SqueezeModel:
         xn = np.interp(xi_n, xi, xs)
         xn[0], xn[-1] = self.x_min, x_hi
         xn = np.unique(xn)
-        glx, glw = _gl(NODE_ORDER)
-        ratios = np.zeros(0)
-        dvs = np.zeros(0)
-        t_out = np.empty((xn.size, 1))
-        scal = np.empty((xn.size, 7))
-        _node_kernel(self.tab, self.par, xn, ratios, dvs, glx, glw, NODE_WIDTH,
-                     t_out, scal)
-        from scipy.interpolate import CubicSpline
-
-        def coef(y):
-            cs = CubicSpline(xn, y, bc_type="not-a-knot")
-            return np.ascontiguousarray(cs.c)
-
+        vals = self._node_values(xn, np.zeros(0), np.zeros(0))
         self._fast = {
             "xn": np.ascontiguousarray(xn), "bucket": build_bucket_map(xn, ascending=True),
-            "lnS": coef(np.log(scal[:, 5])), "lnv": coef(np.log(scal[:, 0])),
-            "lnvs": coef(np.log(scal[:, 1])), "dxi": dxi,
+            "lnS": _spline(xn, np.log(vals["S"])), "lnv": _spline(xn, np.log(vals["vinf"])),
+            "lnvs": _spline(xn, np.log(vals["vs"])), "dxi": dxi, "S": vals["S"],
         }
-        self._targets[("ratio", 1.01)] = coef(t_out[:, 0] / scal[:, 5])
-        self._fast_scal = scal
+        self._targets[("ratio", 1.01)] = _spline(xn, vals["T"][0] / vals["S"])
         return self._fast
+
+    def _node_values(self, xs, ratios, dvs, order=NODE_ORDER, width=NODE_WIDTH):
+        """Reduced quad-engine results at x0 = xs (default start): T (targets × nodes), S..."""
+        n = xs.size
+        glx, glw = _gl(order)
+        T = np.empty((1 + ratios.size + dvs.size, n))
+        uinf, ustart, trelax = np.empty(n), np.empty(n), np.empty(n)
+        _node_kernel(self.tab, self.par, np.ascontiguousarray(xs, dtype=np.float64),
+                     np.ascontiguousarray(ratios, dtype=np.float64),
+                     np.ascontiguousarray(dvs, dtype=np.float64), glx, glw, float(width), T,
+                     uinf, ustart, trelax)
+        return {"T": T, "vinf": uinf, "vs": ustart, "S": trelax}
+
+    def packed(self, targets):
+        """Coefficients (intervals, 3 + len(targets), 4): ln S, ln v∞, ln v_start, then t̃/S
+        of each target — C order, so one case reads one contiguous block."""
+        key = tuple(targets)
+        cache = self.__dict__.setdefault("_packed", {})
+        if key not in cache:
+            fast = self._fast_nodes()
+            parts = [fast["lnS"], fast["lnv"], fast["lnvs"]] + [self.target_coef(k, v)
+                                                                 for k, v in targets]
+            cache[key] = np.ascontiguousarray(np.stack(parts).transpose(2, 0, 1))
+        return cache[key]
 
     def target_coef(self, kind, value):
         """Spline coefficients of t̃(start → target)/S for one target ('ratio' or 'dv')."""
@@ -566,16 +588,17 @@ class SqueezeModel:
             key = (kind, float(value))
             if key not in self._targets:
                 xn = fast["xn"]
-                glx, glw = _gl(NODE_ORDER)
-                t_out = np.empty((xn.size, 2 if kind == "ratio" else 2))
-                scal = np.empty((xn.size, 7))
                 r = np.array([value]) if kind == "ratio" else np.zeros(0)
                 dv = np.array([value]) if kind == "dv" else np.zeros(0)
-                _node_kernel(self.tab, self.par, xn, r, dv, glx, glw, NODE_WIDTH, t_out, scal)
-                from scipy.interpolate import CubicSpline
-                cs = CubicSpline(xn, t_out[:, 1] / scal[:, 5], bc_type="not-a-knot")
-                self._targets[key] = np.ascontiguousarray(cs.c)
+                vals = self._node_values(xn, r, dv)
+                self._targets[key] = _spline(xn, vals["T"][1] / vals["S"])
             return self._targets[key]
+
+
+def _spline(x, y):
+    """Not-a-knot cubic spline coefficients (4, n-1), local in (x - x_j) (Horner order)."""
+    from scipy.interpolate import CubicSpline
+    return np.ascontiguousarray(CubicSpline(x, y, bc_type="not-a-knot").c)
 
 
 @njit(cache=True)
@@ -643,9 +666,9 @@ def squeeze_model(tables, theory="average", sigma_trap=None) -> SqueezeModel:
 
 
 # =========================================================================== API helpers
-def _values(name, value, unit, allow_empty=True):
-    arr = np.atleast_1d(as_float_array(name, value)).ravel()
-    return arr
+def _values(name, value, unit):
+    """A 1-D float64 array of ``value`` (for ratios / du / times), or raise naming it."""
+    return np.atleast_1d(as_float_array(name, value)).ravel()
 
 
 def _col(prefix, value):
@@ -707,6 +730,8 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory="average", u_start=None,
     if not 2 <= quad_order <= 64:
         raise ValueError(f"quad_order = {quad_order!r} is invalid: must be an integer in [2, 64]")
     quad_width = float(check_positive("quad_width", quad_width, "[-] (panel width in ln(u-u_inf))"))
+    if sigma_trap is not None:
+        sigma_trap = float(check_positive("sigma_trap", sigma_trap, "[-] (reduced conductivity floor)"))
     model = squeeze_model(tables, theory, sigma_trap)
     h = model.h_rms
     p0 = check_positive("p0", p0, "[Pa]")
@@ -742,69 +767,58 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory="average", u_start=None,
         return np.ascontiguousarray(np.broadcast_to(a, shape).ravel(), dtype=np.float64)
 
     p0f, Ef, Rf, etaf, usf = (flat(a) for a in (p0, E_star, R, eta, us))
-    x0 = np.log(p0f / Ef)
-    tau0 = 3.0 * etaf * Rf * Rf / (2.0 * h * h * p0f)
-    vs = usf / h
     rr = np.ascontiguousarray(ratios)
     dv = np.ascontiguousarray(du / h)
     nt = 1 + rr.size + dv.size
-    t_out = np.empty((n, nt))
-    u_out = np.empty((n, times_sorted.size))
-    scal = np.empty((n, 7))
+    out = {"T": np.empty((nt, n)), "U": np.empty((times_sorted.size, n))}
+    for k in ("u_inf", "u_start", "t_relax", "u_trap", "t_trap", "fluid_load_fraction", "tau0"):
+        out[k] = np.empty(n)
+    out["status"] = np.empty(n, dtype=np.int8)
+    outs = (out["T"], out["U"], out["u_inf"], out["u_start"], out["t_relax"], out["u_trap"],
+            out["t_trap"], out["fluid_load_fraction"], out["tau0"], out["status"])
     glx, glw = _gl(quad_order)
     tab, par = model.tab, model.par
     if method == "quad":
-        _quad_kernel(tab, par, x0, vs, tau0, rr, dv, times_sorted, glx, glw, quad_width,
-                     t_out, u_out, scal)
+        _quad_kernel(tab, par, p0f, Ef, Rf, etaf, usf, h, rr, dv, times_sorted, glx, glw,
+                     quad_width, *outs)
     else:
         fast = model._fast_nodes()
-        cT = np.ascontiguousarray(np.stack(
-            [model.target_coef("ratio", 1.01)] + [model.target_coef("ratio", r) for r in rr]
-            + [model.target_coef("dv", d) for d in dv]))
-        _fast_kernel(tab, par, x0, vs, tau0, rr, dv, times_sorted, glx, glw, quad_width,
-                     fast["xn"], *fast["bucket"], fast["lnS"], fast["lnv"], fast["lnvs"], cT,
-                     t_out, u_out, scal)
-    return _frame(model, p0f, Ef, Rf, etaf, tau0, rr, du, times, order, t_out, u_out, scal,
-                  u_start is None, vs, x0)
-
-
-def _frame(model, p0, E, R, eta, tau0, ratios, du, times, order, t_out, u_out, scal,
-           default_start, vs, x0):
-    h = model.h_rms
-    status = scal[:, 2]
-    out_of_table = status == ST_OUT
-    trapped = status == ST_TRAPPED
-    vinf = scal[:, 0]
-    bad_start = ~out_of_table & ~trapped & ~(scal[:, 1] > vinf)
-    if np.any(bad_start) and not default_start:
-        i = int(np.flatnonzero(bad_start)[0])
-        raise ValueError(f"u_start = {float(vs[i] * h)!r} is invalid: must be > u_inf = "
-                         f"{float(vinf[i] * h)!r} [m] (p0 = {float(p0[i])!r} Pa, E_star = "
-                         f"{float(E[i])!r} Pa): the film must start above equilibrium")
-    cols = {"p0": p0, "E_star": E, "R": R, "eta": eta, "u_start": scal[:, 1] * h,
-            "u_inf": vinf * h, "t_star": t_out[:, 0]}
+        C = model.packed([("ratio", 1.01)] + [("ratio", float(r)) for r in rr]
+                         + [("dv", float(d)) for d in dv])
+        _fast_kernel(tab, par, p0f, Ef, Rf, etaf, usf, h, rr, dv, times_sorted, glx, glw,
+                     quad_width, fast["xn"], *fast["bucket"], C, *outs)
+    if u_start is not None:
+        bad = (out["status"] == ST_OK) & ~(usf > out["u_inf"])
+        if np.any(bad):
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"u_start = {float(usf[i])!r} is invalid: must be > u_inf = "
+                             f"{float(out['u_inf'][i])!r} [m] (p0 = {float(p0f[i])!r} Pa, "
+                             f"E_star = {float(Ef[i])!r} Pa): the film must start above "
+                             f"equilibrium")
+    cols = {"p0": p0f, "E_star": Ef, "R": Rf, "eta": etaf, "u_start": out["u_start"],
+            "u_inf": out["u_inf"], "t_star": out["T"][0]}
     k = 1
-    for r in ratios:
-        cols[_col("t_ratio", r)] = t_out[:, k]
+    for r in rr:
+        cols[_col("t_ratio", r)] = out["T"][k]
         k += 1
     for d in du:
-        cols[_col("t_du", d)] = t_out[:, k]
+        cols[_col("t_du", d)] = out["T"][k]
         k += 1
     inv = np.empty_like(order)
     inv[order] = np.arange(order.size)
     for j, t in enumerate(times):
-        cols[_col("u_at", t)] = u_out[:, inv[j]] * h
-    cols["tau0"] = tau0
-    cols["t_relax"] = tau0 * scal[:, 5]
-    cols["trapped"] = trapped
-    cols["percolated"] = trapped & (x0 >= model.x_perc)
-    cols["u_trap"] = np.where(trapped, scal[:, 3] * h, np.nan)
-    cols["t_trap"] = np.where(out_of_table, np.nan, scal[:, 6])
-    cols["fluid_load_fraction"] = np.where(out_of_table, np.nan,
-                                           np.where(trapped, 1.0 - scal[:, 4], 0.0))
-    cols["out_of_table"] = out_of_table
+        cols[_col("u_at", t)] = out["U"][inv[j]]
+    status = out["status"]
+    trapped = status == ST_TRAPPED
+    cols.update({"tau0": out["tau0"], "t_relax": out["t_relax"], "trapped": trapped,
+                 "percolated": trapped & (np.log(p0f / Ef) >= model.x_perc)
+                 if np.isfinite(model.x_perc) else np.zeros(n, dtype=bool),
+                 "u_trap": out["u_trap"], "t_trap": out["t_trap"],
+                 "fluid_load_fraction": out["fluid_load_fraction"],
+                 "out_of_table": status == ST_OUT})
     df = pd.DataFrame(cols, copy=False)
     df.attrs.update(_attrs(model))
+    df.attrs["method"] = method
     return df
 
 
@@ -819,7 +833,7 @@ def _attrs(model):
                            f"exact percolation at p/E* = "
                            f"{math.exp(model.x_perc) if np.isfinite(model.x_perc) else math.inf:.8g})"),
         "tail": (f"u > {model.v_top:.6g} h_rms: p = p_top exp(-(u-u_top)/{model.u0:.6g} h_rms), "
-                 f"sigma_bar = v^3 - {model.c_tail:.6g} v"),
+                 f"sigma_bar = y^3 - {model.c_tail:.6g} y, y = u/h_rms + {model.d_tail:.6g}"),
     }
 
 
@@ -852,7 +866,7 @@ def squeeze_history(tables, p0, E_star, R, eta, theory="average", t=None, u_star
     names = [_col("u_at", x) for x in t]
     u = np.array([row[c] for c in names], dtype=np.float64)
     model = squeeze_model(tables, theory, sigma_trap)
-    pc = _p_of_u(model, u / h) * (1.0 if True else 0.0)
+    pc = _p_of_u(model, u / h)
     ratio = pc / (float(p0) / float(E_star))
     from .reduced import flat_separation
     us = float(row["u_start"])

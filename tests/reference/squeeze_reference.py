@@ -19,9 +19,9 @@ to v_b is the quadrature
 (``contact_pressure``, 1e-14 in ln p), v∞ from the direct (A4) at p0.
 
 Above v = V_DIRECT = 200 h_rms (π_c < 1e-80, so π_c/π0 is negligible) the direct core is not
-used: σ̄ = v³(1 - c/v²) with c fitted to the direct σ̄ at V_DIRECT, integrated in closed form
-(the c term is < 4e-5 of σ̄ there and that part of the integral < 1e-4 of t* for every
-case in the tests).
+used: σ̄ = y³ - c y with y = v + d, (c, d) fitted to the direct σ̄ and its slope at
+V_DIRECT, integrated in closed form (σ̄ → v³ is exact to leading order, paper Sec. 3; the
+correction is < 0.5 % of σ̄ there and that part of the integral < 1e-2 of t* in the tests).
 
 Cost: every integrand value is one Newton inverse plus one σ̄ (the effective medium costs
 ~5–10 ms), so a t* takes 0.1–5 s; keep the case count small.
@@ -53,6 +53,7 @@ class SqueezeReference:
         self.lnpi0 = math.log(self.p0 / self.E)
         self.v_inf = float(mean_separation(psd, self.p0, self.E)) / self.h
         self.evals = 0
+        self._tail_cd = None
 
     # -- model pieces (direct core)
     def sigma_bar_at_p(self, p):
@@ -78,14 +79,29 @@ class SqueezeReference:
         return e / (s * -math.expm1(lnp - self.lnpi0))
 
     def _tail(self, a, b):
-        """∫_a^b dv/σ̄ for v >= V_DIRECT (π_c/π0 negligible)."""
-        v = V_DIRECT
-        lnp, s = self.state(v)
-        c = v * v * (1.0 - s / v ** 3)
+        """∫_a^b dv/σ̄ for v >= V_DIRECT (π_c/π0 negligible), σ̄ = y³ - c y, y = v + d, with
+        (c, d) fitted to the direct σ̄ and its slope (central difference) at V_DIRECT.
+
+        (Critical junction: u1(ζc) ≈ ū + 0.33 h_rms at large ū, so σ̄ ≈ (v + d)³; effective
+        medium: σ̄ ≈ v³ - 1.7 v, i.e. φ_p ≈ 1 - 1.7/v²; average: σ̄ = v³.)"""
+        if self._tail_cd is None:
+            v, hv = V_DIRECT, 0.5
+            s = self.state(v)[1]
+            s1 = (self.state(v + hv)[1] - self.state(v - hv)[1]) / (2 * hv)
+            y = v
+            for _ in range(100):
+                dy = (2 * y ** 3 - s1 * y + s) / (6 * y * y - s1)
+                y -= dy
+                if abs(dy) < 1e-15 * y:
+                    break
+            self._tail_cd = (3 * y * y - s1, y - v)
+        c, d = self._tail_cd
+        a, b = a + d, b + d
         ia2 = 1.0 / (a * a)
         ib2 = 0.0 if b == math.inf else 1.0 / (b * b)
-        if abs(c) * ia2 < 1e-8:
-            return 0.5 * (ia2 - ib2) + 0.25 * c * (ia2 ** 2 - ib2 ** 2)
+        if abs(c) * ia2 < 1e-6:
+            return (0.5 * (ia2 - ib2) + 0.25 * c * (ia2 ** 2 - ib2 ** 2)
+                    + c * c / 6.0 * (ia2 ** 3 - ib2 ** 3))
         lb = 0.0 if b == math.inf else math.log1p(-c * ib2)
         return (lb - math.log1p(-c * ia2)) / (2.0 * c)
 
