@@ -25,7 +25,7 @@ _LAZY = {
     "effective_modulus": "elasticity",
     "precompute": "tables", "Tables": "tables",
     "conductivity": "conductivity",
-    "squeeze_out": "squeeze", "squeeze_out_reduced": "reduced",
+    "squeeze_out": "squeeze", "squeeze_history": "squeeze", "squeeze_out_reduced": "reduced",
     "seal_leak": "seal", "seal_profile": "seal",
 }
 __all__ = sorted(_LAZY) + ["__version__"]
