@@ -264,9 +264,12 @@ def _cmd_sweep(a, out, err):
         print(f"error: {len(man['failed'])} surface task(s) crashed, e.g. "
               f"{next(iter(man['failed'].items()))}; rerun to retry", file=err)
         return 1
-    if man["surfaces_with_errors"]:
-        print(f"warning: {len(man['surfaces_with_errors'])} surface(s) have error rows "
+    if man["surfaces_with_error_rows"]:
+        print(f"warning: {len(man['surfaces_with_error_rows'])} surface(s) have error rows "
               f"(see the 'error' column and the manifest)", file=err)
+    if man["surfaces_with_notes"]:
+        print(f"note: {len(man['surfaces_with_notes'])} surface(s) have table notes (e.g. a "
+              f"fallback build; see 'partitions' in the manifest)", file=err)
     return 0
 
 

@@ -52,7 +52,7 @@ def _check_zeta(psd, zeta):
 
 def _arrays(psd):
     qb, c, e, cum3 = psd.kernel_arrays()
-    kinks = np.ascontiguousarray(np.asarray(psd.kinks, dtype=np.float64))
+    kinks = np.ascontiguousarray(np.sort(np.asarray(psd.kinks, dtype=np.float64)))
     return qb, c, e, cum3, kinks
 
 
@@ -122,14 +122,21 @@ def _asymptote_kernel(qb, c, e, cum3, kinks, glx, glw, panel):
     t0 = -120.0
     s0 = 0.0
     s1 = 0.0
+    ik = 0
     while t0 < tau_hi:
         t1 = min(t0 + panel, tau_hi)
-        for ik in range(kinks.size):
+        while ik < kinks.size:
             qk = kinks[ik]
-            if qk > a * (1.0 + math.exp(t0)) and qk < qb[-1]:
-                tk = math.log(qk / a - 1.0)
-                if t0 < tk < t1:
-                    t1 = tk
+            if qk <= a or qk >= qb[-1]:
+                ik += 1
+                continue
+            tk = math.log(qk / a - 1.0)
+            if tk <= t0 + 1e-12:
+                ik += 1
+                continue
+            if tk < t1:
+                t1 = tk
+            break
         half = 0.5 * (t1 - t0)
         mid = 0.5 * (t1 + t0)
         for j in range(glx.size):

@@ -257,7 +257,8 @@ class TabulatedPSD(PSD):
         self.qb = q
         self.c = self.C_samples[:-1]
         self.e = np.log(self.C_samples[1:] / self.C_samples[:-1]) / np.log(q[1:] / q[:-1])
-        self.kinks = ()
+        # the log-log slope changes at every interior sample: quadratures must break there
+        self.kinks = tuple(float(x) for x in q[1:-1])
         self._finish()
 
     def to_dict(self):

@@ -191,6 +191,7 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
     # the integrands are smooth exponentials in tau; split at kinks
     tau_1 = math.log(P * P / (math.pi * a ** 4 * ca))
     nk = kinks.size
+    ik = 0
     t0 = tau_lo
     sF = 0.0
     sg = 0.0
@@ -204,12 +205,19 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
         t1 = t0 + width
         if t1 > tau_hi:
             t1 = tau_hi
-        for ik in range(nk):
+        # the next kink (sorted) beyond the panel start is a panel boundary
+        while ik < nk:
             qk = kinks[ik]
-            if qk > a * (1.0 + math.exp(t0)) and qk < q1:
-                tk = math.log(qk / a - 1.0)
-                if t0 < tk < t1:
-                    t1 = tk
+            if qk <= a or qk >= q1:
+                ik += 1
+                continue
+            tk = math.log(qk / a - 1.0)
+            if tk <= t0 + 1e-12:
+                ik += 1
+                continue
+            if tk < t1:
+                t1 = tk
+            break
         half = 0.5 * (t1 - t0)
         mid = 0.5 * (t1 + t0)
         for j in range(ng):

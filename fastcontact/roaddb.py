@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -34,20 +32,15 @@ DB_KEY = b"fastcontact.roaddb"
 SURFACES_PER_PART = 250
 #: samples per spectrum (log-spaced in q)
 N_Q = 48
+#: accepted rms slope range (asphalt: ξ ~ 1 over these bandwidths); draws outside are redrawn
+MIN_SLOPE, MAX_SLOPE = 0.3, 4.0
 
 
 def _atomic_write_table(table, path: Path):
     import pyarrow.parquet as pq
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
+    from .atomic import atomic_path
+    with atomic_path(path) as tmp:
         pq.write_table(table, tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return path
 
 
@@ -60,26 +53,47 @@ def synthetic_road_psd(rng, n_q=N_Q):
     form C ∝ (1 + (q/q_roll)²)^{-(1+H)} (flat below q_roll, C ∝ q^{-2(1+H)} above), times
     a mild smooth multiplicative "measurement" wiggle (±5 %, log-normal, correlated over
     ~0.3 decade), sampled on ``n_q`` log-spaced points from q0 to q1 and normalised so that
-    the log-log interpolant has exactly the drawn h_rms.
+    the log-log interpolant has exactly the drawn h_rms. Roads have rms slopes of order 1;
+    independent draws would reach ξ ≈ 20, so where ξ > MAX_SLOPE = 4 the cut-off q1 is
+    lowered (not below 1e5 1/m) until ξ = 4, and draws that cannot be fixed that way or have
+    ξ < MIN_SLOPE = 0.3 are redrawn.
     """
     from .psd import TabulatedPSD
-    h_rms = 10.0 ** rng.uniform(-4.0, -3.0)
-    hurst = rng.uniform(0.7, 0.9)
-    lam_r = 10.0 ** rng.uniform(math.log10(1e-3), math.log10(5e-3))
-    q_roll = 2.0 * math.pi / lam_r
-    q0 = q_roll / rng.uniform(4.0, 10.0)
-    q1 = 10.0 ** rng.uniform(5.0, 6.0)
-    q = np.geomspace(q0, q1, n_q)
-    shape = (1.0 + (q / q_roll) ** 2) ** (-(1.0 + hurst))
-    # smooth wiggle: white noise smoothed over ~0.3 decade in log q
-    x = np.log10(q)
-    noise = rng.standard_normal(n_q)
-    width = 0.15
-    kern = np.exp(-0.5 * ((x[:, None] - x[None, :]) / width) ** 2)
-    smooth = kern @ noise / np.sqrt((kern ** 2).sum(axis=1))
-    shape = shape * np.exp(0.05 * smooth)
-    psd = TabulatedPSD(q, shape)
-    C = shape * (h_rms / psd.h_rms) ** 2
+
+    def spectrum(q0, q1, n_q, q_roll, hurst, h_rms, smooth_noise):
+        q = np.geomspace(q0, q1, n_q)
+        shape = (1.0 + (q / q_roll) ** 2) ** (-(1.0 + hurst)) * np.exp(0.05 * smooth_noise)
+        psd = TabulatedPSD(q, shape)
+        return q, shape * (h_rms / psd.h_rms) ** 2, psd.rms_slope * h_rms / psd.h_rms
+
+    while True:
+        h_rms = 10.0 ** rng.uniform(-4.0, -3.0)
+        hurst = rng.uniform(0.7, 0.9)
+        lam_r = 10.0 ** rng.uniform(math.log10(1e-3), math.log10(5e-3))
+        q_roll = 2.0 * math.pi / lam_r
+        q0 = q_roll / rng.uniform(4.0, 10.0)
+        q1 = 10.0 ** rng.uniform(5.0, 6.0)
+        # smooth "measurement" wiggle: white noise smoothed over ~0.3 decade in log q
+        x = np.linspace(0.0, 1.0, n_q)
+        noise = rng.standard_normal(n_q)
+        kern = np.exp(-0.5 * ((x[:, None] - x[None, :]) / (0.15 / 3.0)) ** 2)
+        smooth = kern @ noise / np.sqrt((kern ** 2).sum(axis=1))
+        q, C, slope = spectrum(q0, q1, n_q, q_roll, hurst, h_rms, smooth)
+        if slope > MAX_SLOPE:
+            # too steep for a road: lower q1 (not below 1e5) until the rms slope is MAX_SLOPE
+            lo, hi = math.log(1e5), math.log(q1)
+            if spectrum(q0, 1e5, n_q, q_roll, hurst, h_rms, smooth)[2] > MAX_SLOPE:
+                continue
+            for _ in range(40):
+                mid = 0.5 * (lo + hi)
+                if spectrum(q0, math.exp(mid), n_q, q_roll, hurst, h_rms, smooth)[2] > MAX_SLOPE:
+                    hi = mid
+                else:
+                    lo = mid
+            q1 = math.exp(lo)
+            q, C, slope = spectrum(q0, q1, n_q, q_roll, hurst, h_rms, smooth)
+        if slope >= MIN_SLOPE:
+            break
     params = dict(h_rms=h_rms, hurst=hurst, q0=q0, q_roll=q_roll, q1=q1)
     return params, q, C
 

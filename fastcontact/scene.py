@@ -20,8 +20,10 @@ wrong dimension is an error naming the key.
     ``"parabolic"`` or a list of relative values at equally spaced stations),
     ``pressure_model`` (``"mean"`` | ``"peak"``), ``du_complete`` (default 1 µm), ``ratios``,
     ``u_start`` (default: 1 cm, the paper's u(0)).
-    seal: ``dp`` (pressure difference p_a - p_b), ``p_b``, ``profile`` (``"uniform"`` |
-    ``"hertz"``), ``f_N`` (load per unit length, Hertz profile).
+    seal: ``dp`` (pressure difference p_a - p_b), ``p_b``, ``alpha_cj`` (junction factor,
+    σ_cj ∝ α_cj³; the paper's experiment: 0.54), ``profile`` (``"uniform"``: needs ``p0`` and
+    ``geometry.L`` | ``"hertz"``: needs ``geometry.R`` and ``f_N``, load per unit length;
+    p0 and L then follow from the Hertz contact), ``geometry.L_y``.
 ``[surfaces.<name>]``
     exactly one of ``table = "file.parquet"`` (a table file: relative to the scene file, else
     one of the embedded default tables, see :func:`default_table_path`), ``psd = "file.csv"``
@@ -35,8 +37,8 @@ wrong dimension is an error naming the key.
     ``R`` (block radius; squeeze, tire; O-ring radius for a Hertz seal), ``L`` (seal width),
     ``L_y`` (seal length).
 ``[tables]``
-    ``gamma``, ``a_perc``, ``alpha_cj`` (options of :func:`fastcontact.tables.precompute`),
-    ``cache_dir``.
+    ``gamma``, ``a_perc``, ``alpha_cj`` (options of :func:`fastcontact.tables.precompute`;
+    a seal study takes α_cj in ``[study]``), ``cache_dir``.
 ``[outputs]``
     ``columns`` (result columns wanted, ``*`` patterns allowed; default all),
     ``figures`` (figure names wanted; default none).
@@ -59,6 +61,7 @@ from __future__ import annotations
 import dataclasses
 import datetime as _dt
 import difflib
+from decimal import Decimal
 import fnmatch
 import hashlib
 import itertools
@@ -67,7 +70,6 @@ import math
 import os
 import re
 import sys
-import tempfile
 import time
 import tomllib
 from pathlib import Path
@@ -112,17 +114,19 @@ UNIT_EXAMPLES = {
     "density": "kg/m^3, g/cm^3", "time": "s, ms, us, min", "velocity": "m/s, km/h",
     "force_per_length": "N/m, N/mm", "dimensionless": "no unit",
 }
+# factors are exact decimals, so that "10 um" is the double nearest to 1e-5
+_D = Decimal
 _BASE_UNITS = {
-    "m": (1.0, (0, 1, 0)), "s": (1.0, (0, 0, 1)), "g": (1e-3, (1, 0, 0)),
-    "Pa": (1.0, (1, -1, -2)), "N": (1.0, (1, 1, -2)), "bar": (1e5, (1, -1, -2)),
-    "P": (0.1, (1, -1, -1)),            # poise (cP = 1 mPa s)
+    "m": (_D(1), (0, 1, 0)), "s": (_D(1), (0, 0, 1)), "g": (_D("1e-3"), (1, 0, 0)),
+    "Pa": (_D(1), (1, -1, -2)), "N": (_D(1), (1, 1, -2)), "bar": (_D("1e5"), (1, -1, -2)),
+    "P": (_D("0.1"), (1, -1, -1)),            # poise (cP = 1 mPa s)
 }
 _EXACT_UNITS = {
-    "min": (60.0, (0, 0, 1)), "h": (3600.0, (0, 0, 1)),
-    "psi": (6894.757293168361, (1, -1, -2)), "1": (1.0, (0, 0, 0)),
+    "min": (_D(60), (0, 0, 1)), "h": (_D(3600), (0, 0, 1)),
+    "psi": (_D("6894.757293168361"), (1, -1, -2)), "1": (_D(1), (0, 0, 0)),
 }
-_PREFIXES = {"n": 1e-9, "u": 1e-6, "µ": 1e-6, "μ": 1e-6, "m": 1e-3, "c": 1e-2, "k": 1e3,
-             "M": 1e6, "G": 1e9}
+_PREFIXES = {"n": _D("1e-9"), "u": _D("1e-6"), "µ": _D("1e-6"), "μ": _D("1e-6"),
+             "m": _D("1e-3"), "c": _D("1e-2"), "k": _D("1e3"), "M": _D("1e6"), "G": _D("1e9")}
 _NUMBER = re.compile(r"^\s*([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*(.*?)\s*$")
 _TOKEN = re.compile(r"^([A-Za-zµμ]+|1)(?:\^?([+-]?\d+)|([²³]))?$")
 
@@ -154,9 +158,9 @@ def parse_unit(text):
     text = text.replace("·", " ").replace("⋅", " ").replace("*", " ").strip()
     if text.count("/") > 1:
         raise UnitError(f"unit {text!r} has more than one '/'")
-    num, _, den = text.partition("/")
-    factor, dims = 1.0, (0, 0, 0)
-    for part, sign in ((num, 1), (den, -1)):
+    num, slash, den = text.partition("/")
+    factor, dims = _D(1), (0, 0, 0)
+    for part, sign in ((num, 1), (den, -1)) if slash else ((num, 1),):
         toks = part.split()
         if sign == -1 and not toks:
             raise UnitError(f"unit {text!r} has nothing after '/'")
@@ -164,7 +168,7 @@ def parse_unit(text):
             f, d = _unit_token(tok)
             factor *= f ** sign
             dims = tuple(a + sign * b for a, b in zip(dims, d))
-    if num.strip() == "" and den:
+    if slash and num.strip() == "":
         raise UnitError(f"unit {text!r} has nothing before '/' (write 1/{den.strip()})")
     return factor, dims
 
@@ -184,7 +188,7 @@ def parse_quantity(key, value, dim):
         if not m:
             raise ValueError(f"{key} = {value!r}: not a number with a unit "
                              f"(e.g. {_example(dim)!r})")
-        x, unit = float(m.group(1)), m.group(2)
+        x, unit = _D(m.group(1)), m.group(2)
         if unit:
             try:
                 factor, dims = parse_unit(unit)
@@ -195,6 +199,7 @@ def parse_quantity(key, value, dim):
                 raise ValueError(f"{key} = {value!r}: wrong unit {unit!r}, {key} is a "
                                  f"{dim.replace('_', ' ')} ({UNIT_EXAMPLES[dim]})")
             x *= factor
+        x = float(x)
     else:
         x = float(value)
     if not math.isfinite(x):
@@ -310,15 +315,15 @@ DEFAULTS = {
 
 
 def _did_you_mean(word, choices):
-    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.5)
+    choices = [str(c) for c in choices]
+    close = difflib.get_close_matches(str(word), choices, n=1, cutoff=0.5)
+    if not close:   # "Radius" → "R", "viscosity_eta" → "eta": prefix/containment, any case
+        w = str(word).lower()
+        close = [c for c in choices if w.startswith(c.lower()) or (len(c) > 2 and c.lower() in w)]
+        close.sort(key=len, reverse=True)
     if close:
         return f" (did you mean {close[0]!r}?)"
     return f" (allowed: {', '.join(map(str, choices))})"
-
-
-def _fmt_num(x):
-    """Short, stable text of a number for column names (1.01 → '1.01', 1e-6 → '1e-06')."""
-    return repr(float(x)) if 1e-3 <= abs(x) < 1e4 else f"{x:.6g}"
 
 
 # =========================================================================== files
@@ -518,9 +523,9 @@ def _parse_axis(key, value, spec, problems):
         missing = [k for k in ("start", "stop", "num") if k not in value]
         for k in missing:
             problems.append(f"{key}: range table needs '{k}' (keys: start, stop, num, log)")
-        if unknown or missing:
+        if missing:
             return None
-        ok = True
+        ok = not unknown
         try:
             a = _parse_scalar(f"{key}.start", value["start"], spec)
         except ValueError as exc:
@@ -577,10 +582,6 @@ def _parse_strlist(key, value, problems):
         problems.append(f"{key} = {value!r}: must be a list of strings")
         return None
     return list(vals)
-
-
-def _table_needed(kind, columns, figures):
-    return True
 
 
 def load_scene(scene, *, for_sweep=False, base_dir=None):
@@ -713,7 +714,8 @@ def load_scene(scene, *, for_sweep=False, base_dir=None):
 
     # ------------------------------------------------------------ required / defaults
     if kind is not None:
-        if "p0" not in axes and ("study", "p0") not in given:
+        hertz = kind == "seal" and fixed.get("profile") == "hertz"
+        if "p0" not in axes and ("study", "p0") not in given and not hertz:
             problems.append("study.p0 is missing: the nominal pressure, e.g. p0 = \"0.2 MPa\"")
         if "theory" not in axes and ("study", "theory") not in given:
             axes["theory"] = [defaults["theory"]]
@@ -735,7 +737,7 @@ def load_scene(scene, *, for_sweep=False, base_dir=None):
             for k in ("dp",):
                 if k not in axes and ("study", k) not in given:
                     problems.append(f"study.{k} is missing (seal study): the pressure difference")
-            for k in ("L", "L_y"):
+            for k in (("L_y",) if fixed.get("profile") == "hertz" else ("L", "L_y")):
                 if k not in axes and ("geometry", k) not in given:
                     problems.append(f"geometry.{k} is missing (seal study)")
             for k in ("p_b", "alpha_cj"):
@@ -746,6 +748,12 @@ def load_scene(scene, *, for_sweep=False, base_dir=None):
                     if k not in axes and (sec, k) not in given:
                         problems.append(f"{sec}.{k} is missing: profile = 'hertz' needs the O-ring "
                                         f"radius R and the load per unit length f_N")
+                for k, sec in (("p0", "study"), ("L", "geometry")):
+                    if (sec, k) in given:
+                        problems.append(f"{sec}.{k}: not used with profile = 'hertz' (the Hertz "
+                                        f"contact sets the pressure profile and the width 2a)")
+            elif ("geometry", "R") in given:
+                problems.append("geometry.R: only used by a seal with profile = 'hertz'")
             elif ("study", "f_N") in given:
                 problems.append("study.f_N: only used with profile = 'hertz'")
     if ("fluid", "eta") not in given:
@@ -942,7 +950,7 @@ def available_columns(kind, fixed):
         from .tire import tire_columns
         return tire_columns(fixed.get("ratios", DEFAULTS["tire"]["ratios"]))
     if kind == "seal":
-        return list(SEAL_COLUMNS)
+        return list(SEAL_COLUMNS) + (list(SEAL_HERTZ_COLUMNS) if fixed.get("profile") == "hertz" else [])
     raise ValueError(f"kind = {kind!r} is invalid")
 
 
@@ -954,10 +962,19 @@ def squeeze_columns(ratios, du, times):
     """Result columns of a squeeze study (names independent of the engine's formatting)."""
     return (["u_start", "u_inf", "t_star"] + [f"t_ratio_{_num_name(r)}" for r in ratios]
             + [f"t_du_{_num_name(d)}" for d in du] + [f"u_at_{_num_name(t)}" for t in times]
-            + ["trapped", "u_trap", "fluid_load_fraction"])
+            + list(SQUEEZE_TAIL))
 
 
-SEAL_COLUMNS = ("Q", "lift_off", "percolated")
+#: further squeeze_out columns offered by squeeze studies
+SQUEEZE_TAIL = ("tau0", "t_relax", "trapped", "percolated", "u_trap", "t_trap",
+                "fluid_load_fraction", "out_of_table")
+
+
+#: boolean result columns (typed as nullable booleans when a case fails)
+BOOL_COLUMNS = frozenset({"trapped", "percolated", "out_of_table", "squeeze_complete",
+                          "lift_off", "converged"})
+SEAL_COLUMNS = ("Q", "lift_off", "percolated", "p_a", "open_inlet", "open_outlet")
+SEAL_HERTZ_COLUMNS = ("a", "L", "p_max", "converged", "error_estimate")
 
 
 def _squeeze_columns(ratios, du, times):
@@ -1065,29 +1082,39 @@ def _col(rows, name):
 
 def _eval_squeeze(tables, rows, theory, fixed, columns):
     from .squeeze import squeeze_out
-    from .tire import _pick
+    from .tire import _pick, squeeze_method
     ratios = [r for r in fixed["ratios"] if f"t_ratio_{_num_name(r)}" in columns]
     du = [d for d in fixed["du"] if f"t_du_{_num_name(d)}" in columns]
     times = [t for t in fixed["times"] if f"u_at_{_num_name(t)}" in columns]
     kw = dict(p0=_col(rows, "p0"), E_star=_col(rows, "E_star"), R=_col(rows, "R"),
               eta=_col(rows, "eta"), theory=theory,
               u_start=_col(rows, "u_start") if "u_start" in rows else None,
-              ratios=tuple(ratios) if ratios else (1.01,), du=tuple(du), times=tuple(times))
+              ratios=tuple(ratios) if ratios else (1.01,), du=tuple(du), times=tuple(times),
+              method=squeeze_method(len(rows)))
     sq = squeeze_out(tables, **kw).reset_index(drop=True)
     if len(sq) != len(rows):
         raise RuntimeError(f"squeeze_out returned {len(sq)} rows for {len(rows)} cases")
     out = {}
-    for name in ("u_start", "u_inf", "t_star", "trapped", "u_trap", "fluid_load_fraction"):
+    for name in ("u_start", "u_inf", "t_star", *SQUEEZE_TAIL):
         if name in columns:
-            if name == "u_start" and "u_start" not in sq and "u_start" in rows:
-                out[name] = _col(rows, "u_start")
-            else:
-                out[name] = sq[name].to_numpy() if name in sq else np.full(len(rows), np.nan)
+            out[name] = sq[name].to_numpy()
     for prefix, vals in (("t_ratio_", ratios), ("t_du_", du), ("u_at_", times)):
         if vals:
             for v, c in zip(vals, _pick(sq, prefix, vals)):
                 out[f"{prefix}{_num_name(v)}"] = sq[c].to_numpy()
+    out["_error"] = _out_of_table_errors(tables, rows, sq["out_of_table"].to_numpy(bool))
     return out
+
+
+def _out_of_table_errors(tables, rows, oot):
+    err = np.full(len(rows), "", dtype=object)
+    if np.any(oot):
+        lo, hi = tables.p_range
+        pb = _col(rows, "p0") / _col(rows, "E_star")
+        for i in np.flatnonzero(oot):
+            err[i] = (f"out_of_table: p0/E_star = {pb[i]:.6g} is outside the tables' range "
+                      f"[{lo:.6g}, {hi:.6g}]")
+    return err
 
 
 def _eval_tire(tables, rows, theory, fixed, columns):
@@ -1097,24 +1124,33 @@ def _eval_tire(tables, rows, theory, fixed, columns):
                         speed=_col(rows, "speed"), rho=_col(rows, "rho"), theory=theory,
                         pressure_profile=fixed["pressure_profile"],
                         pressure_model=fixed["pressure_model"], u_start=_col(rows, "u_start"),
-                        du_complete=fixed["du_complete"], ratios=fixed["ratios"], columns=columns)
-    return {c: df[c].to_numpy() for c in columns}
+                        du_complete=fixed["du_complete"], ratios=fixed["ratios"],
+                        columns=list(dict.fromkeys(list(columns) + ["out_of_table"])))
+    out = {c: df[c].to_numpy() for c in columns}
+    out["_error"] = _out_of_table_errors(tables, rows, df["out_of_table"].to_numpy(bool))
+    return out
 
 
 def _eval_seal(tables, rows, theory, fixed, columns):
     from .seal import seal_leak
     hertz = fixed.get("profile") == "hertz"
-    kw = dict(p0=_col(rows, "p0"), dp=_col(rows, "dp"), L=_col(rows, "L"), L_y=_col(rows, "L_y"),
-              E_star=_col(rows, "E_star"), eta=_col(rows, "eta"), theory=theory,
-              alpha_cj=_col(rows, "alpha_cj"), p_b=_col(rows, "p_b"),
-              profile=fixed.get("profile", "uniform"),
-              R=_col(rows, "R") if hertz else None, f_N=_col(rows, "f_N") if hertz else None)
-    if len(rows) == 1:
-        kw = {k: (v[0] if isinstance(v, np.ndarray) else v) for k, v in kw.items()}
+    kw = dict(dp=_col(rows, "dp"), L_y=_col(rows, "L_y"), E_star=_col(rows, "E_star"),
+              eta=_col(rows, "eta"), theory=theory, alpha_cj=_col(rows, "alpha_cj"),
+              p_b=_col(rows, "p_b"), profile=fixed.get("profile", "uniform"))
+    if hertz:
+        kw.update(R=_col(rows, "R"), f_N=_col(rows, "f_N"))
+    else:
+        kw.update(p0=_col(rows, "p0"), L=_col(rows, "L"))
     df = seal_leak(tables, **kw).reset_index(drop=True)
     if len(df) != len(rows):
         raise RuntimeError(f"seal_leak returned {len(df)} rows for {len(rows)} cases")
-    return {c: df[c].to_numpy() for c in columns}
+    out = {c: df[c].to_numpy() for c in columns}
+    err = np.full(len(rows), "", dtype=object)
+    if "converged" in df:
+        bad = ~df["converged"].to_numpy(bool)
+        err[bad] = "seal solver did not converge (see error_estimate)"
+    out["_error"] = err
+    return out
 
 
 _ENGINES = {"squeeze": _eval_squeeze, "tire": _eval_tire, "seal": _eval_seal}
@@ -1140,6 +1176,8 @@ def evaluate_cases(kind, tables, cases, fixed, columns):
             out = engine(tables, rows, theory, fixed, columns)
             for c in columns:
                 res[c][idx] = out[c]
+            if "_error" in out:
+                err[idx] = out["_error"]
             continue
         except Exception:  # noqa: BLE001 - fall back to one case at a time (errors kept per row)
             pass
@@ -1149,15 +1187,31 @@ def evaluate_cases(kind, tables, cases, fixed, columns):
                 out = engine(tables, row, theory, fixed, columns)
                 for c in columns:
                     res[c][i] = np.ravel(out[c])[0]
+                if "_error" in out:
+                    err[i] = np.ravel(out["_error"])[0]
             except _ROW_ERRORS as exc:
                 err[i] = f"{type(exc).__name__}: {exc}"
-    df = pd.DataFrame({c: _tidy(res[c]) for c in columns})
+    # an output that is also an input column (e.g. u_start given in the scene) is not repeated
+    df = pd.DataFrame({c: _tidy(res[c], c) for c in columns if c not in cases.columns})
     df["error"] = pd.Series(err, dtype=str)
     return df
 
 
-def _tidy(a):
+def empty_results(columns, n, exclude=()):
+    """Typed all-missing result columns (NaN floats, NA booleans) for ``n`` failed cases."""
+    import pandas as pd
+    return pd.DataFrame({c: (pd.array([None] * n, dtype="boolean") if c in BOOL_COLUMNS
+                             else np.full(n, np.nan)) for c in columns if c not in exclude})
+
+
+def _tidy(a, name=None):
     """object array of results → float or bool array where possible."""
+    if name in BOOL_COLUMNS:
+        import pandas as pd
+        return pd.array([None if (v is None or (isinstance(v, float) and math.isnan(v)))
+                         else bool(v) for v in a], dtype="boolean") \
+            if any(v is None or (isinstance(v, float) and math.isnan(v)) for v in a) \
+            else a.astype(bool)
     vals = [v for v in a if not (v is None or (isinstance(v, float) and math.isnan(v)))]
     if vals and all(isinstance(v, (bool, np.bool_)) for v in vals):
         if len(vals) == len(a):
@@ -1171,48 +1225,24 @@ def _tidy(a):
 
 # =========================================================================== outputs
 def _atomic_write_bytes(path: Path, data: bytes):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        _chmod_default(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
-
-
-def _chmod_default(path):
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(path, 0o666 & ~umask)
+    from .atomic import write_bytes_atomic
+    return write_bytes_atomic(path, data)
 
 
 def write_parquet_atomic(df, path: Path, metadata: dict | None = None):
-    """Write ``df`` to ``path`` (temporary file + os.replace) with JSON ``metadata`` under
-    the key ``fastcontact``."""
+    """Write ``df`` to ``path`` atomically (temporary file + os.replace) with JSON ``metadata``
+    under the key-value metadata key ``fastcontact``."""
     import pyarrow as pa
     import pyarrow.parquet as pq
+    from .atomic import atomic_path
     path = Path(path)
     table = pa.Table.from_pandas(df, preserve_index=False)
     meta = dict(table.schema.metadata or {})
     if metadata is not None:
         meta[b"fastcontact"] = json.dumps(metadata, sort_keys=True, default=_json_default).encode()
     table = table.replace_schema_metadata(meta)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
+    with atomic_path(path) as tmp:
         pq.write_table(table, tmp)
-        _chmod_default(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return path
 
 
@@ -1346,21 +1376,39 @@ def run_scene(scene, outdir, *, cache_dir=None, log=None):
 _MAX_CURVES = 8
 
 
-def _fig_cases(scene, results):
-    """Up to _MAX_CURVES (surface, row) pairs for curve figures: every surface, first cases."""
-    per = max(1, _MAX_CURVES // max(len(scene.surfaces), 1))
+_SQUEEZE_KEYS = ("theory", "p0", "E", "nu", "E2", "nu2", "E_star", "eta", "R", "u_start")
+_SI_UNIT = {"p0": "Pa", "E": "Pa", "E_star": "Pa", "E2": "Pa", "eta": "Pa s", "R": "m",
+            "u_start": "m", "dp": "Pa", "p_b": "Pa", "L": "m", "L_y": "m", "rho": "kg/m^3",
+            "speed": "m/s", "footprint_length": "m", "f_N": "N/m", "nu": "-", "nu2": "-",
+            "alpha_cj": "-"}
+_UNIT_LABEL = {"p0": (1e6, "MPa"), "E": (1e6, "MPa"), "E_star": (1e6, "MPa"), "eta": (1e-3, "mPa s"),
+               "R": (1e-2, "cm"), "u_start": (1e-3, "mm"), "dp": (1e3, "kPa"), "L": (1e-3, "mm")}
+
+
+def _fig_cases(scene, results, distinct=None):
+    """Up to _MAX_CURVES (surface, row) pairs: every surface, first cases (distinct in the
+    ``distinct`` columns, e.g. the squeeze parameters, which the footprint speed is not)."""
+    g_all = results[results["error"] == ""]
+    if distinct:
+        g_all = g_all.drop_duplicates(subset=["surface"] + [c for c in distinct if c in g_all])
+    per = max(1, _MAX_CURVES // max(g_all["surface"].nunique(), 1))
     out = []
-    for name, g in results.groupby("surface", sort=False):
-        g = g[g["error"] == ""]
+    for name, g in g_all.groupby("surface", sort=False):
         out.extend((name, r) for _, r in g.head(per).iterrows())
     return out[:_MAX_CURVES]
 
 
-def _case_label(scene, name, row):
+def _case_label(scene, name, row, keys=None):
     parts = [scene.surfaces[name].label or name] if name in scene.surfaces else [name]
     for k, v in scene.axes.items():
-        if len(v) > 1:
-            parts.append(f"{k}={row[k]}" if k == "theory" else f"{k}={float(row[k]):.3g}")
+        if len(v) > 1 and (keys is None or k in keys):
+            if k == "theory":
+                parts.append(str(row[k]))
+            elif k in _UNIT_LABEL:
+                f, u = _UNIT_LABEL[k]
+                parts.append(f"{k} = {float(row[k]) / f:.3g} {u}")
+            else:
+                parts.append(f"{k} = {float(row[k]):.3g}")
     return ", ".join(parts)
 
 
@@ -1378,7 +1426,7 @@ def _make_scene_figure(scene, fig, tables, results, figdir):
     if scene.kind == "tire" or (scene.kind == "squeeze" and fig == "u_of_t"):
         from .figures.tire_figures import plot_tire_curves, tire_curve
         curves = []
-        for name, row in _fig_cases(scene, results):
+        for name, row in _fig_cases(scene, results, _SQUEEZE_KEYS):
             p_eval = float(row["p_eval"]) if "p_eval" in row else float(row["p0"])
             if scene.kind == "tire" and "p_eval" not in row:
                 from .tire import profile_factors
@@ -1391,14 +1439,14 @@ def _make_scene_figure(scene, fig, tables, results, figdir):
                                      theory=row["theory"],
                                      u_start=float(row["u_start"]) if "u_start" in row and
                                      np.isfinite(float(row["u_start"])) else None,
-                                     ratios=ratios, du=du, label=_case_label(scene, name, row)))
+                                     ratios=ratios, du=du,
+                                     label=_case_label(scene, name, row, _SQUEEZE_KEYS)))
         t_mark = None
         if scene.kind == "tire":
-            t_fp = float(results["footprint_length"].iloc[0] / results["speed"].iloc[0])
-            t_mark = t_fp
+            t_mark = sorted(set((results["footprint_length"] / results["speed"]).round(12)))
         quantity = "du" if fig == "du_of_t" else "u"
         return plot_tire_curves(curves, path, quantity, scene.title, t_mark=t_mark,
-                                t_mark_label="time in footprint" if t_mark else None)
+                                t_mark_label="time in footprint:" if t_mark else None)
     from .figures.reduced_figures import _new_figure, _save_atomic
     f = _new_figure(figsize=(6.4, 4.8))
     ax = f.subplots()
@@ -1408,10 +1456,11 @@ def _make_scene_figure(scene, fig, tables, results, figdir):
         for k, ((name, theory), g) in enumerate(ok.groupby(["surface", "theory"], sort=False)):
             gg = g.sort_values(x)
             y = gg["t_star"].to_numpy(float)
-            ax.plot(gg[x].to_numpy(float), y, "o-", ms=3, label=f"{name} ({theory})")
+            lab = scene.surfaces[name].label if name in scene.surfaces and scene.surfaces[name].label else name
+            ax.plot(gg[x].to_numpy(float), y, "o-", ms=3, label=f"{lab} ({theory})")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel(f"{x} (SI)")
+        ax.set_xlabel(f"{x} ({_SI_UNIT.get(x, 'SI')})")
         ax.set_ylabel(r"squeeze-out time $t^*$ (s), $\bar u(t^*) = 1.01\,\bar u_\infty$")
     elif fig == "leak_rate":
         others = [k for k, v in scene.axes.items() if len(v) > 1 and k != "dp"]
@@ -1419,11 +1468,12 @@ def _make_scene_figure(scene, fig, tables, results, figdir):
             gg = g.sort_values("dp")
             Q = gg["Q"].to_numpy(float)
             m = np.isfinite(Q) & (Q > 0)
-            lab = name + "".join(f", {o}={v:.3g}" if not isinstance(v, str) else f", {v}"
-                                 for o, v in zip(others, key))
-            ax.plot((gg["dp"] / gg["p0"]).to_numpy(float)[m], Q[m], "o-", ms=3, label=lab)
+            lab = _case_label(scene, name, gg.iloc[0], others)
+            pref = _seal_p_ref(scene, gg)
+            ax.plot((gg["dp"].to_numpy(float) / pref)[m], Q[m], "o-", ms=3, label=lab)
         ax.set_yscale("log")
-        ax.set_xlabel(r"$\Delta p / p_0$")
+        ax.set_xlabel(r"$\Delta p / p_0$" + (r" ($p_0$: Hertz peak pressure)"
+                                             if scene.fixed.get("profile") == "hertz" else ""))
         ax.set_ylabel(r"leak rate $Q$ (m$^3$/s)")
     elif fig == "profiles":
         from .seal import seal_profile
@@ -1431,7 +1481,7 @@ def _make_scene_figure(scene, fig, tables, results, figdir):
         T = tables[name]
         ax2 = ax.twinx()
         for j, frac in enumerate((0.0, 0.5, 0.9)):
-            dp = frac * float(row["p0"])
+            dp = frac * float(_seal_p_ref(scene, row.to_frame().T)[0])
             prof = seal_profile(T, **_seal_profile_kwargs(scene, row, dp))
             x = prof["x"].to_numpy(float) * 1e3
             ax.plot(x, prof["p_cont"].to_numpy(float) / 1e3, color=COLORS_SEAL[j],
@@ -1441,7 +1491,7 @@ def _make_scene_figure(scene, fig, tables, results, figdir):
         ax.set_xlabel("x (mm)")
         ax.set_ylabel(r"contact pressure $p_{\rm cont}$ (kPa)")
         ax2.set_ylabel(r"separation $\bar u$ (µm), dashed")
-    ax.legend(fontsize=8, frameon=False)
+    ax.legend(fontsize=8, frameon=False, loc="upper center" if fig == "profiles" else "best")
     ax.set_title(scene.title, fontsize=9)
     ax.grid(True, which="major", lw=0.3, alpha=0.5)
     return _save_atomic(f, path)
@@ -1450,10 +1500,21 @@ def _make_scene_figure(scene, fig, tables, results, figdir):
 COLORS_SEAL = ("tab:blue", "tab:orange", "tab:red")
 
 
+def _seal_p_ref(scene, rows):
+    """p0 of a flat ring, or the Hertz peak pressure, for each row [Pa]."""
+    if scene.fixed.get("profile") == "hertz":
+        from .seal import hertz_contact
+        return np.asarray(hertz_contact(rows["R"].to_numpy(float), rows["f_N"].to_numpy(float),
+                                        rows["E_star"].to_numpy(float))[1], float).ravel()
+    return rows["p0"].to_numpy(float)
+
+
 def _seal_profile_kwargs(scene, row, dp):
-    hertz = scene.fixed.get("profile") == "hertz"
-    return dict(p0=float(row["p0"]), dp=dp, L=float(row["L"]), L_y=float(row["L_y"]),
-                E_star=float(row["E_star"]), eta=float(row["eta"]), theory=row["theory"],
-                alpha_cj=float(row["alpha_cj"]), p_b=float(row["p_b"]),
-                profile=scene.fixed.get("profile", "uniform"),
-                R=float(row["R"]) if hertz else None, f_N=float(row["f_N"]) if hertz else None)
+    kw = dict(dp=dp, L_y=float(row["L_y"]), E_star=float(row["E_star"]), eta=float(row["eta"]),
+              theory=row["theory"], alpha_cj=float(row["alpha_cj"]), p_b=float(row["p_b"]),
+              profile=scene.fixed.get("profile", "uniform"))
+    if scene.fixed.get("profile") == "hertz":
+        kw.update(R=float(row["R"]), f_N=float(row["f_N"]))
+    else:
+        kw.update(p0=float(row["p0"]), L=float(row["L"]))
+    return kw

@@ -15,11 +15,14 @@ and has one row per case; everything else is (re)computed. Since partitions are 
 and atomically, an interrupted sweep (even SIGKILL) neither loses nor duplicates a row. An
 output folder holding a *different* sweep is refused.
 
-Cluster: by default a ``distributed.LocalCluster`` of worker processes (spawned, not forked),
-``threads_per_worker`` = cores // workers, with ``NUMBA_NUM_THREADS`` set to that and
-``NUMBA_THREADING_LAYER=workqueue`` (the default OpenMP layer is not fork-safe), and
-``OMP/MKL/OPENBLAS_NUM_THREADS=1``; or an existing scheduler with ``--scheduler ADDR`` (its
-workers' environment is theirs to set).
+Cluster: by default a ``distributed.LocalCluster`` of worker processes (started with the
+'spawn' method, never forked) with ``threads_per_worker=1`` — the numba kernels hold the GIL,
+so a second Dask thread would add no throughput, and numba's ``workqueue`` layer aborts when
+two threads enter parallel kernels at once — and the cores left to each worker given to
+numba: ``NUMBA_NUM_THREADS`` = cores // workers. ``NUMBA_THREADING_LAYER=workqueue`` (the
+default OpenMP layer is not fork-safe), ``OMP/MKL/OPENBLAS_NUM_THREADS=1``. With
+``--scheduler ADDR`` an existing cluster is used; its workers' environment and thread count
+are theirs to set (use 1 thread per worker, or the 'tbb'/'omp' layer with spawned workers).
 
 Read the results with :func:`read_sweep` (or ``pandas.read_parquet(OUT / "data")``).
 """
@@ -36,7 +39,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
 
 __all__ = ["run_sweep", "read_sweep", "sweep_key", "worker_environment", "SweepError"]
 
@@ -76,17 +78,20 @@ def sweep_key(scene, db_fingerprint):
 
 
 # ============================================================================ the task
-def _surface_task(sid, q, C, scene, cases, outpath, key, cache_dir):
+def _surface_task(sid, q, C, scene, outpath, key, cache_dir):
     """Build tables for one surface, evaluate all cases, write the partition atomically."""
     import pandas as pd
     from .psd import TabulatedPSD
-    from .scene import (SurfaceSpec, evaluate_cases, obtain_tables, write_parquet_atomic)
+    from .scene import (SurfaceSpec, empty_results, evaluate_cases, obtain_tables,
+                        write_parquet_atomic)
     t0 = time.perf_counter()
-    note, table_meta = None, {}
+    cases = scene.cases()
+    note, table_meta, t_tab = None, {}, math.nan
     try:
         psd = TabulatedPSD(q, C, convention="persson")
         spec = SurfaceSpec(sid, "inline", psd_obj=psd)
         T, rec = obtain_tables(spec, scene.theories, dict(scene.table_options), cache_dir)
+        t_tab = time.perf_counter() - t0
         note = rec["note"]
         table_meta = {k: rec[k] for k in ("surface_hash", "columns_sha256", "theories", "nodes",
                                           "build_seconds", "action")}
@@ -94,13 +99,16 @@ def _surface_task(sid, q, C, scene, cases, outpath, key, cache_dir):
     except (ValueError, RuntimeError, ArithmeticError) as exc:
         # the surface itself is unusable: every case gets the error (rows still exist once)
         note = f"{type(exc).__name__}: {exc}"
-        res = pd.DataFrame({c: np.full(len(cases), np.nan) for c in scene.columns})
+        res = empty_results(scene.columns, len(cases), exclude=cases.columns)
         res["error"] = note
     df = pd.concat([pd.DataFrame({"surface_id": sid}, index=cases.index), cases, res], axis=1)
+    n_err = int((df["error"] != "").sum())
     meta = {"sweep_key": key, "surface_id": sid, "rows": len(df), "table": table_meta,
-            "note": note, "seconds": time.perf_counter() - t0}
+            "note": note, "error_rows": n_err, "table_seconds": t_tab,
+            "seconds": time.perf_counter() - t0}
     write_parquet_atomic(df, outpath, meta)
-    return {"surface_id": sid, "rows": len(df), "seconds": meta["seconds"], "note": note,
+    return {"surface_id": sid, "rows": len(df), "seconds": time.perf_counter() - t0,
+            "table_seconds": t_tab, "note": note, "error_rows": n_err,
             "file": Path(outpath).name}
 
 
@@ -169,14 +177,18 @@ def _start_cluster(workers, scheduler):
         return Client(scheduler, timeout="30s"), None, {"scheduler": scheduler}
     cores = os.cpu_count() or 1
     n = int(workers) if workers else cores
-    tpw = max(1, cores // n)
-    env = worker_environment(tpw)
+    # one task at a time per worker process: numba kernels hold the GIL (more Dask threads
+    # would not add throughput) and the workqueue layer must not be entered by two threads
+    # at once; the cores a worker has to itself go to numba's parallel kernels instead
+    numba_threads = max(1, cores // n)
+    env = worker_environment(numba_threads)
     with dask.config.set({"distributed.worker.multiprocessing-method": "spawn",
                           "distributed.worker.daemon": False}):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=tpw, processes=True,
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                dashboard_address=None, env=env, silence_logs=logging.ERROR)
     client = Client(cluster)
-    return client, cluster, {"local_workers": n, "threads_per_worker": tpw, "env": env}
+    return client, cluster, {"local_workers": n, "threads_per_worker": 1,
+                             "numba_threads_per_worker": numba_threads, "env": env}
 
 
 def run_sweep(db, outdir, scene, *, scheduler=None, workers=None, convention=None,
@@ -252,7 +264,8 @@ def run_sweep(db, outdir, scene, *, scheduler=None, workers=None, convention=Non
             if meta and meta.get("sweep_key") == key and meta.get("rows") == n_cases \
                     and meta.get("surface_id") == sid:
                 done[sid] = {"surface_id": sid, "rows": n_cases, "file": p.name,
-                             "seconds": meta.get("seconds"), "note": meta.get("note")}
+                             "seconds": meta.get("seconds"), "note": meta.get("note"),
+                             "error_rows": meta.get("error_rows", 0)}
             else:
                 p.unlink()
     todo = [sid for sid in ids if sid not in done]
@@ -277,16 +290,15 @@ def run_sweep(db, outdir, scene, *, scheduler=None, workers=None, convention=Non
         client, cluster, cluster_info = _start_cluster(workers, scheduler)
         manifest["cluster"] = cluster_info
         try:
-            sc_f = client.scatter(sc, broadcast=True)
-            cases_f = client.scatter(cases, broadcast=True)
+            # the scene (a few kB) travels with each task; the cases are rebuilt from it there
+            # (nothing is scattered, so a lost worker loses no shared data)
             cdir = str(Path(cache_dir).resolve()) if cache_dir else None
             futs = {}
             for sid in todo:
                 q, C = spectra[sid]
-                f = client.submit(_surface_task, sid, q, C, sc_f, cases_f,
+                f = client.submit(_surface_task, sid, q, C, sc,
                                   str(partition_path(outdir, sid).resolve()), key, cdir,
-                                  key=f"surface-{key[:8]}-{_safe_name(sid)}", pure=False,
-                                  retries=0)
+                                  key=f"surface-{key[:8]}-{_safe_name(sid)}", pure=False)
                 futs[f] = sid
             last_write = time.perf_counter()
             for fut in as_completed(list(futs)):
@@ -311,7 +323,9 @@ def run_sweep(db, outdir, scene, *, scheduler=None, workers=None, convention=Non
     manifest["computed_this_run"] = len(todo) - len(manifest["failed"])
     manifest["status"] = "complete" if len(done) == len(ids) else "incomplete"
     manifest["rows"] = int(sum(d["rows"] for d in done.values()))
-    manifest["surfaces_with_errors"] = sorted(sid for sid, d in done.items() if d.get("note"))
+    manifest["surfaces_with_error_rows"] = sorted(sid for sid, d in done.items()
+                                                  if d.get("error_rows"))
+    manifest["surfaces_with_notes"] = sorted(sid for sid, d in done.items() if d.get("note"))
     manifest["finished_utc"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
     _atomic_json(mpath, manifest)
     return manifest

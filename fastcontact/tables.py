@@ -539,7 +539,12 @@ def _quintic_np(x, x0, x1, y0, y1, d0, d1, s0, s1, deriv=False):
 
 
 def _interval_errors(lnp, cols, mids, theories):
-    """Relative midpoint errors of each column's interpolant, per interval."""
+    """Relative midpoint errors of each column's interpolant, per interval (inf: overflow)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _interval_errors_raw(lnp, cols, mids, theories)
+
+
+def _interval_errors_raw(lnp, cols, mids, theories):
     x0, x1 = lnp[:-1], lnp[1:]
     xm = 0.5 * (x0 + x1)
     lnu = np.log(cols["u"])

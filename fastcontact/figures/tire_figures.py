@@ -55,7 +55,7 @@ def tire_curve(tables, *, p0, E_star, R, eta, theory="average", u_start=PAPER["u
     from fastcontact.reduced import flat_separation
     from fastcontact.squeeze import squeeze_history, squeeze_out
     sq = squeeze_out(tables, p0=p0, E_star=E_star, R=R, eta=eta, theory=theory, u_start=u_start,
-                     ratios=tuple(ratios), du=(du,), times=())
+                     ratios=tuple(ratios), du=(du,), times=(), method="quad")
     row = sq.iloc[0]
     from fastcontact.tire import _pick
     t_r = [float(row[c]) for c in _pick(sq, "t_ratio_", list(ratios))]
@@ -109,19 +109,24 @@ def plot_tire_curves(curves, path, quantity="u", title="", t_mark=None, t_mark_l
         ax.axhline(lvl, color="k", lw=0.8, ls=":")
         ax.annotate(rf"$\Delta u$ = {lvl:g} µm", xy=(0.02, lvl), xycoords=("axes fraction", "data"),
                     xytext=(0, 3), textcoords="offset points", fontsize=8)
-        ymin = min(ymin, lvl / 10)
+        ymin = max(min(ymin, lvl / 10), lvl * 1e-4)
         ax.set_ylabel(r"$\Delta u = \bar u(t) - \bar u(\infty)$ (µm)")
     else:
         ax.set_ylabel(r"separation $\bar u$ (mm)")
-    if t_mark is not None:
-        ax.axvline(t_mark, color="0.3", lw=1.2)
-        ax.annotate(t_mark_label or "", xy=(t_mark, 0.97), xycoords=("data", "axes fraction"),
-                    xytext=(-3, 0), textcoords="offset points", ha="right", va="top",
-                    fontsize=8, color="0.3", rotation=90)
+    marks = [] if t_mark is None else list(np.atleast_1d(t_mark))
+    for tm in marks:
+        ax.axvline(tm, color="0.3", lw=1.2)
+        ax.annotate(f"{t_mark_label or ''} {tm * 1e3:.3g} ms", xy=(tm, 0.97),
+                    xycoords=("data", "axes fraction"), xytext=(-3, 0),
+                    textcoords="offset points", ha="right", va="top", fontsize=8, color="0.3",
+                    rotation=90)
     ax.set_xscale("log")
     ax.set_yscale("log")
     if np.isfinite(ymin) and ymax > 0:
         ax.set_ylim(ymin / 1.5, ymax * 1.5)
+    if marks:
+        lo, hi = ax.get_xlim()
+        ax.set_xlim(lo, max(hi, 2.0 * max(marks)))
     ax.set_xlabel(r"squeeze time $t$ (s)")
     ax.plot([], [], color="0.4", lw=0.8, ls="--", label=r"$\bar u/\bar u_\infty$ = 1.1, 1.01, 1.001 (- -, -., :)")
     if quantity == "u":
@@ -151,11 +156,12 @@ def make_tire_figures(outdir, tables=None) -> list[Path]:
                          theory=PAPER["theory"], u_start=PAPER["u_start"], label=label)
               for label, T in tables.items()]
     t_fp = PAPER["footprint_length"] / PAPER["speed"]
-    title = (r"tread block on wet asphalt: $p_0$ = 0.2 MPa, $E$ = 10 MPa, $R$ = 2 cm, water, "
+    title = ("tread block on wet asphalt (paper Sec. 5)\n"
+             r"$p_0$ = 0.2 MPa, $E$ = 10 MPa ($\nu$ = 0.5), $R$ = 2 cm, water, "
              r"average-separation $\sigma_{\rm eff}$")
     return [plot_tire_curves(curves, outdir / "tire_u_of_t.png", "u", title),
             plot_tire_curves(curves, outdir / "tire_du_of_t.png", "du", title, t_mark=t_fp,
-                             t_mark_label="footprint 0.1 m at 30 m/s")]
+                             t_mark_label="footprint 0.1 m at 30 m/s:")]
 
 
 if __name__ == "__main__":  # pragma: no cover

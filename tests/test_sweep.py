@@ -1,0 +1,211 @@
+"""Issue #6: sweeps over a road database on Dask — partitions, manifest, resume after SIGKILL."""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from fastcontact.roaddb import generate_road_database
+from fastcontact.sweep import SweepError, read_sweep, run_sweep
+
+SCENE = """
+title = "sweep test"
+[study]
+kind = "squeeze"
+theory = "average"
+p0 = ["0.1 MPa", "0.2 MPa", "0.4 MPa"]
+ratios = [1.1, 1.01]
+du = ["1 um"]
+[material]
+E = "10 MPa"
+nu = 0.5
+[fluid]
+eta = ["1 mPa s", "5 mPa s"]
+[geometry]
+R = "2 cm"
+[outputs]
+columns = ["u_inf", "t_star", "t_ratio_*", "t_du_*", "trapped"]
+"""
+N_CASES = 6
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory):
+    base = tmp_path_factory.mktemp("sweep")
+    db = generate_road_database(base / "db", 14, seed=3, surfaces_per_part=5)
+    scene = base / "scene.toml"
+    scene.write_text(SCENE)
+    clean = base / "clean"
+    man = run_sweep(db, clean, scene, workers=2, progress=False)
+    return base, db, scene, clean, man
+
+
+def _env():
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(Path(__file__).resolve().parents[1]) + os.pathsep + env.get("PYTHONPATH", "")
+    return env
+
+
+def test_clean_sweep_complete(setup):
+    base, db, scene, clean, man = setup
+    assert man["status"] == "complete" and man["n_surfaces"] == 14
+    assert man["cases_per_surface"] == N_CASES and man["rows"] == 14 * N_CASES
+    assert man["cluster"]["local_workers"] == 2
+    assert man["cluster"]["env"]["NUMBA_THREADING_LAYER"] == "workqueue"
+    files = sorted((clean / "data").glob("part-*.parquet"))
+    assert len(files) == 14                                   # one partition per surface
+    df = read_sweep(clean)
+    assert len(df) == 14 * N_CASES
+    assert not df.duplicated(["surface_id", "case_id"]).any()
+    assert (df.error == "").all()
+    assert {"u_inf", "t_star", "t_ratio_1.1", "t_ratio_1.01", "t_du_1e-06", "trapped"} <= set(df.columns)
+    # the whole folder reads as one dataset too
+    assert len(pd.read_parquet(clean / "data")) == 14 * N_CASES
+
+
+def test_sweep_rows_equal_direct_evaluation(setup):
+    """A partition holds exactly what evaluating the scene on that surface gives."""
+    from fastcontact.roaddb import open_road_database
+    from fastcontact.scene import build_tables, evaluate_cases, load_scene
+    base, db, scene, clean, man = setup
+    d = open_road_database(db)
+    sc = load_scene(scene, for_sweep=True)
+    sid = d.ids[4]
+    T, _ = build_tables(d.psd(sid), sc.theories, sc.table_options)
+    assert T.theories == ("average",)
+    ref = evaluate_cases(sc.kind, T, sc.cases(), sc.fixed, sc.columns)
+    got = read_sweep(clean).query("surface_id == @sid").reset_index(drop=True)
+    for c in ("u_inf", "t_star", "t_du_1e-06"):
+        assert np.array_equal(got[c].to_numpy(float), ref[c].to_numpy(float)), c
+
+
+def test_rerun_skips_everything(setup, tmp_path):
+    base, db, scene, clean, man = setup
+    before = {p.name: p.stat().st_mtime_ns for p in (clean / "data").glob("*.parquet")}
+    m2 = run_sweep(db, clean, scene, workers=1, progress=False)
+    assert m2["computed_this_run"] == 0 and m2["resumed_with_completed"] == 14
+    assert m2["status"] == "complete"
+    after = {p.name: p.stat().st_mtime_ns for p in (clean / "data").glob("*.parquet")}
+    assert before == after
+
+
+def test_other_scene_into_same_outdir_refused(setup, tmp_path):
+    base, db, scene, clean, man = setup
+    other = tmp_path / "other.toml"
+    other.write_text(SCENE.replace('"0.4 MPa"', '"0.5 MPa"'))
+    with pytest.raises(SweepError, match="different sweep"):
+        run_sweep(db, clean, other, workers=1, progress=False)
+
+
+def test_damaged_partition_recomputed(setup, tmp_path):
+    import shutil
+    base, db, scene, clean, man = setup
+    out = tmp_path / "dmg"
+    shutil.copytree(clean, out)
+    victim = sorted((out / "data").glob("part-*.parquet"))[3]
+    victim.write_bytes(victim.read_bytes()[:200])           # truncated
+    (out / "data" / ".part-x.parquet.123.tmp").write_bytes(b"junk")   # stale temp file
+    m = run_sweep(db, out, scene, workers=1, progress=False)
+    assert m["computed_this_run"] == 1 and m["status"] == "complete"
+    assert not list((out / "data").glob(".*.tmp"))
+    a, b = read_sweep(out), read_sweep(clean)
+    pd.testing.assert_frame_equal(a, b)
+
+
+def test_kill_and_resume(setup, tmp_path):
+    """SIGKILL a running sweep after some partitions exist; rerun the same command; every
+    (surface, case) appears exactly once and the values equal a clean run."""
+    base, db, scene, clean, man = setup
+    out = tmp_path / "killed"
+    cmd = [sys.executable, "-m", "fastcontact.cli", "sweep", str(db), "-o", str(out),
+           "--scene", str(scene), "--workers", "1"]
+    proc = subprocess.Popen(cmd, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            start_new_session=True)
+    try:
+        deadline = time.time() + 240
+        n = 0
+        while time.time() < deadline:
+            n = len(list((out / "data").glob("part-*.parquet"))) if (out / "data").exists() else 0
+            if n >= 3 or proc.poll() is not None:
+                break
+            time.sleep(0.02)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)       # the sweep, its cluster and workers
+        proc.wait(timeout=60)
+    done_at_kill = len(list((out / "data").glob("part-*.parquet")))
+    assert proc.returncode == -signal.SIGKILL, proc.stderr.read().decode()[-2000:]
+    assert 0 < done_at_kill < 14, f"{done_at_kill} partitions at kill time"
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["status"] == "running"
+    # rerun the same command
+    r = subprocess.run(cmd + ["--no-progress"], env=_env(), capture_output=True, timeout=600)
+    assert r.returncode == 0, r.stderr.decode()[-3000:]
+    m2 = json.loads((out / "manifest.json").read_text())
+    assert m2["status"] == "complete"
+    assert m2["resumed_with_completed"] >= done_at_kill
+    assert m2["computed_this_run"] == 14 - m2["resumed_with_completed"]
+    got = read_sweep(out)
+    assert len(got) == 14 * N_CASES
+    assert not got.duplicated(["surface_id", "case_id"]).any()
+    pairs = set(zip(got.surface_id, got.case_id))
+    ref = read_sweep(clean)
+    assert pairs == set(zip(ref.surface_id, ref.case_id))
+    pd.testing.assert_frame_equal(got, ref)
+
+
+def test_sweep_cli_bad_input(setup, tmp_path):
+    from fastcontact.cli import main
+    base, db, scene, clean, man = setup
+    import io
+    err = io.StringIO()
+    assert main(["sweep", str(tmp_path / "nodb"), "-o", str(tmp_path / "o"), "--scene", str(scene)],
+                err=err) == 2
+    assert "nodb" in err.getvalue() and len(err.getvalue().strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(SCENE.replace('eta = ["1 mPa s", "5 mPa s"]', 'eta = "5 mPa"'))
+    err = io.StringIO()
+    assert main(["sweep", str(db), "-o", str(tmp_path / "o2"), "--scene", str(bad)], err=err) == 2
+    assert "fluid.eta" in err.getvalue() and "wrong unit" in err.getvalue()
+    assert not (tmp_path / "o2").exists()
+
+
+def test_broken_surface_gets_error_rows_and_external_scheduler(setup, tmp_path):
+    """A surface whose spectrum is unusable yields one error row per case (never missing rows);
+    ``scheduler=`` runs on an existing cluster."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    from distributed import LocalCluster
+    from fastcontact.roaddb import CONVENTION_KEY
+    base, db, scene, clean, man = setup
+    good = pd.read_parquet(db)
+    first = good[good.surface_id == good.surface_id.iloc[0]][["surface_id", "q", "C"]]
+    bad = first.assign(surface_id="broken", C=np.where(np.arange(len(first)) == 5, 0.0, first.C))
+    dbx = tmp_path / "dbx"
+    dbx.mkdir()
+    t = pa.Table.from_pandas(pd.concat([first, bad]), preserve_index=False)
+    pq.write_table(t.replace_schema_metadata({CONVENTION_KEY: b"persson"}), dbx / "x.parquet")
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster:
+        m = run_sweep(dbx, tmp_path / "o", scene, scheduler=cluster.scheduler_address,
+                      progress=False)
+    assert m["status"] == "complete" and m["cluster"] == {"scheduler": cluster.scheduler_address}
+    assert m["surfaces_with_error_rows"] == ["broken"]
+    df = read_sweep(tmp_path / "o")
+    assert len(df) == 2 * N_CASES
+    b = df[df.surface_id == "broken"]
+    assert (b.error.str.contains("C = 0.0")).all() and b.t_star.isna().all()
+    assert b.trapped.isna().all()
+    g = df[df.surface_id != "broken"]
+    assert (g.error == "").all() and np.isfinite(g.t_star).all()
+    # partitions share one schema: the folder reads as one dataset
+    assert len(pd.read_parquet(tmp_path / "o" / "data")) == 2 * N_CASES
