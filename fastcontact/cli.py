@@ -90,6 +90,10 @@ def build_parser():
     ti = tsub.add_parser("info", help="show a table file's metadata")
     ti.add_argument("file")
     ti.add_argument("--json", action="store_true", help="print the raw metadata as JSON")
+    td = tsub.add_parser("defaults", help="rebuild the embedded default tables (tables/, package data)")
+    td.add_argument("-o", "--output-dir", action="append",
+                    help="folder to write to (repeatable; default: the package data and the "
+                         "checkout's tables/ folder)")
 
     w = sub.add_parser("sweep", help="evaluate a scene on every surface of a road database (Dask)")
     w.add_argument("database", help="road database (Parquet dataset or folder of PSD files)")
@@ -253,6 +257,16 @@ def _cmd_tables_info(a, out, err):
     return 0
 
 
+def _cmd_tables_defaults(a, out, err):
+    from .defaults import build_default_tables
+    built = build_default_tables(a.output_dir)
+    for name, t in built.items():
+        e = t.info["interpolation_error"]
+        print(f"{name}: {t.info['nodes']} nodes, built in {t.info['build_seconds']:.2f} s, "
+              f"max interpolation error {max(e.values()):.1e}", file=out)
+    return 0
+
+
 def _cmd_sweep(a, out, err):
     from .sweep import run_sweep
     man = run_sweep(a.database, a.outdir, a.scene, scheduler=a.scheduler, workers=a.workers,
@@ -338,7 +352,8 @@ def main(argv=None, out=None, err=None):
             parser.print_help(out)
             return EXIT_BAD_INPUT
         if a.command == "tables":
-            cmd = {"build": _cmd_tables_build, "info": _cmd_tables_info}.get(a.tables_command)
+            cmd = {"build": _cmd_tables_build, "info": _cmd_tables_info,
+                   "defaults": _cmd_tables_defaults}.get(a.tables_command)
         elif a.command == "roaddb":
             cmd = {"generate": _cmd_roaddb_generate, "info": _cmd_roaddb_info}.get(a.roaddb_command)
         else:

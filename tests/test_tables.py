@@ -265,3 +265,12 @@ def test_sigma_bar_direct_emt_error_estimate_is_honest(psd):
     ref, _, _ = sigma_bar(psd, p, "emt", tol=1e-12)
     assert np.all(np.abs(s / ref - 1) <= np.maximum(ex["error_estimate"], 1e-12) * 10)
     assert np.all(np.abs(s / ref - 1) < 1e-7)
+
+
+def test_cli_rebuilds_default_tables_into_a_folder(tmp_path):
+    from fastcontact.cli import main
+
+    assert main(["tables", "defaults", "-o", str(tmp_path)]) == 0
+    for name in DEFAULT_SURFACES:
+        rebuilt = Tables.from_parquet(tmp_path / f"{name}.parquet")
+        assert rebuilt.equals(load_default_tables(name), rtol=1e-10)
