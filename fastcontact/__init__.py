@@ -26,7 +26,7 @@ _LAZY = {
     "precompute": "tables", "Tables": "tables",
     "conductivity": "conductivity",
     "squeeze_out": "squeeze", "squeeze_history": "squeeze", "squeeze_out_reduced": "reduced",
-    "seal_leak": "seal", "seal_profile": "seal",
+    "seal_leak": "seal", "seal_profile": "seal", "seal_elastic": "seal", "hertz_contact": "seal",
 }
 __all__ = sorted(_LAZY) + ["__version__"]
 

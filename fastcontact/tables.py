@@ -309,7 +309,7 @@ class Tables:
             raise TableRangeError(
                 f"{name} = {v!r} is invalid: outside the table, which covers {name}/E* in "
                 f"[{lo:.6g}, {hi:.6g}] (that is [{lo * e:.6g}, {hi * e:.6g}] Pa at E* = {e:g} Pa)")
-        return np.ascontiguousarray(np.clip(pb, lo, hi))
+        return np.clip(pb, lo, hi)
 
     # ------------------------------------------------------------------ evaluation
     def mean_separation(self, p, E_star):
@@ -317,7 +317,7 @@ class Tables:
         pb = self._pbar("p", p, E_star)
         out = np.empty(pb.size)
         _eval_u_kernel(self.kernel_data(self.theories[0]), np.ascontiguousarray(np.log(pb).ravel()), out)
-        return out.reshape(pb.shape) * self.h_rms
+        return (out.reshape(pb.shape) * self.h_rms)[()]
 
     def contact_pressure(self, u, E_star):
         """Contact pressure p_cont [Pa] at mean separation u [m] (inverse of ū(p))."""
@@ -334,7 +334,7 @@ class Tables:
         lnq = np.ascontiguousarray(np.clip(np.log(ub), self._lnu[-1], self._lnu[0]).ravel())
         out = np.empty(lnq.size)
         _eval_p_kernel(self.kernel_data(self.theories[0]), lnq, out)
-        return out.reshape(ub.shape) * E_star
+        return (out.reshape(ub.shape) * E_star)[()]
 
     def sigma_bar(self, p, E_star, theory):
         """Reduced conductivity σ̄ = 12ησ_eff/h_rms³ [-] at contact pressure p [Pa]."""
@@ -342,7 +342,7 @@ class Tables:
         pb = self._pbar("p", p, E_star)
         out = np.empty(pb.size)
         _eval_sigma_kernel(tab, np.ascontiguousarray(np.log(pb).ravel()), out)
-        return out.reshape(pb.shape)
+        return out.reshape(pb.shape)[()]
 
     def conductivity(self, p, E_star, eta, theory):
         """σ_eff [m³/(Pa·s)] at contact pressure p [Pa]; exactly 0 where percolated."""
