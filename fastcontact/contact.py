@@ -24,7 +24,7 @@ from numba import njit
 
 from ._validate import check_positive, check_range
 from .psd import PSD
-from .quadrature import (PANEL, area_state, gauss_legendre, m3_from, psd_value, q_for_m3,
+from .quadrature import (PANEL, area_state, clip_at_kink, gauss_legendre, m3_from, psd_value, q_for_m3,
                          separation_integrals, u1_at)
 from .special import EULER_GAMMA, K_ZERO, erfinv, k_table
 
@@ -124,19 +124,7 @@ def _asymptote_kernel(qb, c, e, cum3, kinks, glx, glw, panel):
     s1 = 0.0
     ik = 0
     while t0 < tau_hi:
-        t1 = min(t0 + panel, tau_hi)
-        while ik < kinks.size:
-            qk = kinks[ik]
-            if qk <= a or qk >= qb[-1]:
-                ik += 1
-                continue
-            tk = math.log(qk / a - 1.0)
-            if tk <= t0 + 1e-12:
-                ik += 1
-                continue
-            if tk < t1:
-                t1 = tk
-            break
+        t1, ik = clip_at_kink(kinks, ik, a, qb[-1], t0, min(t0 + panel, tau_hi))
         half = 0.5 * (t1 - t0)
         mid = 0.5 * (t1 + t0)
         for j in range(glx.size):

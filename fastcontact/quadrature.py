@@ -137,6 +137,27 @@ def q_for_m3(qb, c, e, cum3, target):
 
 
 @njit(cache=True)
+def clip_at_kink(kinks, ik, a, q1, t0, t1):
+    """End of the panel [t0, t1] in τ = ln(q/a - 1), clipped at the next (sorted) kink.
+
+    Returns (t1, ik) with ik advanced past kinks at or before t0.
+    """
+    while ik < kinks.size:
+        qk = kinks[ik]
+        if qk <= a or qk >= q1:
+            ik += 1
+            continue
+        tk = math.log(qk / a - 1.0)
+        if tk <= t0 + 1e-12:
+            ik += 1
+            continue
+        if tk < t1:
+            t1 = tk
+        break
+    return t1, ik
+
+
+@njit(cache=True)
 def f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder):
     """F(s0) and g(s0) of the module docstring."""
     x = s0 * s0
@@ -190,7 +211,6 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
     # tau_1, and q - a ~ a at tau = 0), growing to GRADE_MAX * panel away from them where
     # the integrands are smooth exponentials in tau; split at kinks
     tau_1 = math.log(P * P / (math.pi * a ** 4 * ca))
-    nk = kinks.size
     ik = 0
     t0 = tau_lo
     sF = 0.0
@@ -205,19 +225,7 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
         t1 = t0 + width
         if t1 > tau_hi:
             t1 = tau_hi
-        # the next kink (sorted) beyond the panel start is a panel boundary
-        while ik < nk:
-            qk = kinks[ik]
-            if qk <= a or qk >= q1:
-                ik += 1
-                continue
-            tk = math.log(qk / a - 1.0)
-            if tk <= t0 + 1e-12:
-                ik += 1
-                continue
-            if tk < t1:
-                t1 = tk
-            break
+        t1, ik = clip_at_kink(kinks, ik, a, q1, t0, t1)
         half = 0.5 * (t1 - t0)
         mid = 0.5 * (t1 + t0)
         for j in range(ng):

@@ -1447,7 +1447,7 @@ def _make_scene_figure(scene, fig, tables, results, figdir):
         quantity = "du" if fig == "du_of_t" else "u"
         return plot_tire_curves(curves, path, quantity, scene.title, t_mark=t_mark,
                                 t_mark_label="time in footprint:" if t_mark else None)
-    from .figures.reduced_figures import _new_figure, _save_atomic
+    from .figures.canvas import new_figure as _new_figure, save_png as _save_atomic
     f = _new_figure(figsize=(6.4, 4.8))
     ax = f.subplots()
     ok = results[results["error"] == ""]

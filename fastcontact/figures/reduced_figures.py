@@ -17,17 +17,14 @@ Run as a script: ``python -m fastcontact.figures.reduced_figures [outdir]``.
 """
 from __future__ import annotations
 
-import os
 import sys
-import tempfile
 from pathlib import Path
 
 import matplotlib.ticker
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from fastcontact.reduced import flat_separation_reduced, squeeze_out_reduced, u_of_t_reduced
+from fastcontact.figures.canvas import new_figure as _new_figure, save_png as _save_atomic
 
 __all__ = ["make_reduced_figures"]
 
@@ -35,31 +32,6 @@ ALPHA = 0.5
 BETA = 1.0
 KAPPAS_FIG2 = (1e-4, 1e-3, 1e-2, 1e-1)
 RATIO = 1.01
-
-
-def _save_atomic(fig, path: Path) -> Path:
-    """Write ``fig`` as PNG to a temporary file in the target directory, then rename."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png.tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)          # mkstemp creates 0600
-        fig.savefig(tmp, format="png", dpi=150)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
-
-
-def _new_figure(**kw):
-    """A pyplot-free Figure on the Agg canvas (no global backend switch, no figure manager)."""
-    fig = Figure(layout="constrained", **kw)
-    FigureCanvasAgg(fig)
-    return fig
 
 
 def _figure_u_of_t(path: Path) -> Path:

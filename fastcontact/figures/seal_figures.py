@@ -29,15 +29,14 @@ Run as a script: ``python -m fastcontact.figures.seal_figures [outdir]``.
 from __future__ import annotations
 
 import math
-import os
 import sys
-import tempfile
 from pathlib import Path
 
 import matplotlib.ticker
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from fastcontact.atomic import atomic_path
 
 __all__ = ["make_seal_figures", "seal_experiment", "EXPERIMENT"]
 
@@ -63,21 +62,9 @@ THEORY_STYLE = {"critical_junction": ("tab:red", "-", r"critical junction ($\alp
 
 # --------------------------------------------------------------------------- atomic writes
 def _atomic(path: Path, write):
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix + ".tmp",
-                               dir=path.parent)
-    os.close(fd)
-    try:
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
+    with atomic_path(path, suffix=Path(path).suffix + ".tmp") as tmp:
         write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
+    return Path(path)
 
 
 def _save_png(fig, path):

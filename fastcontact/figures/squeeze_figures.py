@@ -25,14 +25,11 @@ Run as a script: ``python -m fastcontact.figures.squeeze_figures [outdir]``.
 """
 from __future__ import annotations
 
-import os
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
+from fastcontact.figures.canvas import new_figure as _new_figure, save_png as _save_atomic
 
 __all__ = ["make_squeeze_figures", "copper_surface", "COPPER"]
 
@@ -49,29 +46,6 @@ THEORY_LABEL = {"average": "1: average separation", "critical_junction": "2: cri
 def copper_surface():
     from fastcontact import SelfAffinePSD
     return SelfAffinePSD(**COPPER)
-
-
-def _save_atomic(fig, path: Path) -> Path:
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png.tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        fig.savefig(tmp, format="png", dpi=150)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
-
-
-def _new_figure(**kw):
-    fig = Figure(layout="constrained", **kw)
-    FigureCanvasAgg(fig)
-    return fig
 
 
 def _histories(tables, t):

@@ -23,6 +23,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from fastcontact.figures.canvas import new_figure as _new_figure, save_png as _save_atomic
 
 __all__ = ["make_tire_figures", "tire_curve", "plot_tire_curves", "PAPER"]
 
@@ -33,16 +34,6 @@ ROADS = (("asphalt_072mm", r"surface 1: $h_{\rm rms}$ = 0.72 mm"),
          ("asphalt_024mm", r"surface 2: $h_{\rm rms}$ = 0.24 mm"))
 COLORS = ("tab:red", "tab:blue", "tab:green", "tab:purple", "tab:orange", "tab:brown",
           "tab:pink", "tab:olive")
-
-
-def _save_atomic(fig, path):
-    from fastcontact.figures.reduced_figures import _save_atomic as save
-    return save(fig, Path(path))
-
-
-def _new_figure(**kw):
-    from fastcontact.figures.reduced_figures import _new_figure as new
-    return new(**kw)
 
 
 def tire_curve(tables, *, p0, E_star, R, eta, theory="average", u_start=PAPER["u_start"],

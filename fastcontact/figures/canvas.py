@@ -1,0 +1,25 @@
+"""Shared figure plumbing: pyplot-free Agg figures and atomic PNG writes."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from ..atomic import atomic_path
+
+__all__ = ["new_figure", "save_png"]
+
+
+def new_figure(**kw):
+    """A pyplot-free Figure on the Agg canvas (no global backend switch, no figure manager)."""
+    fig = Figure(layout="constrained", **kw)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def save_png(fig, path) -> Path:
+    """Write ``fig`` as a 150-dpi PNG atomically (temporary name, then rename)."""
+    with atomic_path(path, suffix=".png.tmp") as tmp:
+        fig.savefig(tmp, format="png", dpi=150)
+    return Path(path)
