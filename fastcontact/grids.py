@@ -4,9 +4,9 @@ A grid is the triple ``(log10_min, log10_max, n)``; node i sits at
 ``10**(log10_min + i (log10_max - log10_min)/(n - 1))``. The same triple is written to
 the Parquet metadata. Kernels work in natural logs: ``ln x_i = ln_lo + i * dln``.
 
-Interpolation is cubic Hermite with *exact* derivatives stored beside the values
-(derivatives with respect to ln x), error O(h⁴). Every lookup reports whether its
-argument was inside the table; nothing is extrapolated silently.
+Interpolation is quintic Hermite with *exact* first and second derivatives stored beside
+the values (derivatives with respect to ln x), error O(h⁶). Every lookup reports whether
+its argument was inside the table; nothing is extrapolated silently.
 
 Inverse lookups (contact pressure from separation) use the same nodes: ln ū is monotone
 on the pressure grid, and a uniform bucket map over -ln ū finds the interval in O(1).
@@ -19,7 +19,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-__all__ = ["Grid", "hermite_uniform", "hermite_interval", "quintic_interval", "build_bucket_map", "locate_desc",
+__all__ = ["Grid", "quintic_interval", "build_bucket_map", "locate_desc",
            "locate_asc"]
 
 LN10 = math.log(10.0)
@@ -51,17 +51,6 @@ class Grid(NamedTuple):
 
 
 @njit(cache=True)
-def hermite_interval(x, x0, x1, y0, y1, d0, d1):
-    """Cubic Hermite on [x0, x1] with values y and derivatives d (dy/dx)."""
-    h = x1 - x0
-    u = (x - x0) / h
-    u2 = u * u
-    u3 = u2 * u
-    return ((2 * u3 - 3 * u2 + 1) * y0 + (u3 - 2 * u2 + u) * h * d0
-            + (-2 * u3 + 3 * u2) * y1 + (u3 - u2) * h * d1)
-
-
-@njit(cache=True)
 def quintic_interval(x, x0, x1, y0, y1, d0, d1, s0, s1):
     """Quintic Hermite on [x0, x1] with values y, first derivatives d and second s."""
     h = x1 - x0
@@ -76,20 +65,6 @@ def quintic_interval(x, x0, x1, y0, y1, d0, d1, s0, s1):
             + (10.0 * t3 - 15.0 * t4 + 6.0 * t5) * y1
             + (-4.0 * t3 + 7.0 * t4 - 3.0 * t5) * h * d1
             + 0.5 * (t3 - 2.0 * t4 + t5) * h * h * s1)
-
-
-@njit(cache=True)
-def hermite_uniform(x, x_lo, dx, val, der):
-    """Hermite interpolation at x on the uniform grid x_lo + i dx; x must be in range."""
-    t = (x - x_lo) / dx
-    i = int(t)
-    if i < 0:
-        i = 0
-    n = val.size
-    if i > n - 2:
-        i = n - 2
-    x0 = x_lo + i * dx
-    return hermite_interval(x, x0, x0 + dx, val[i], val[i + 1], der[i], der[i + 1])
 
 
 def build_bucket_map(y_desc, n_buckets=None, ascending=False):

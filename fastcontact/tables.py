@@ -177,20 +177,6 @@ def _eval_sigma_kernel(tab, lnp, out):
 
 
 # =========================================================================== helpers
-def _fd_derivative(y, h):
-    """d y / d x on a uniform grid, 4th-order central (one-sided 4th order at the ends)."""
-    n = y.size
-    d = np.empty(n)
-    if n < 5:
-        return np.gradient(y, h)
-    d[2:-2] = (y[:-4] - 8 * y[1:-3] + 8 * y[3:-1] - y[4:]) / (12 * h)
-    d[0] = (-25 * y[0] + 48 * y[1] - 36 * y[2] + 16 * y[3] - 3 * y[4]) / (12 * h)
-    d[1] = (-3 * y[0] - 10 * y[1] + 18 * y[2] - 6 * y[3] + y[4]) / (12 * h)
-    d[-1] = (25 * y[-1] - 48 * y[-2] + 36 * y[-3] - 16 * y[-4] + 3 * y[-5]) / (12 * h)
-    d[-2] = (3 * y[-1] + 10 * y[-2] - 18 * y[-3] + 6 * y[-4] - y[-5]) / (12 * h)
-    return d
-
-
 def _column_digest(data: dict) -> str:
     h = hashlib.sha256()
     for k in sorted(data):
