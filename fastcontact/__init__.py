@@ -24,7 +24,6 @@ _LAZY = {
     "synthetic_heights": "topography",
     "effective_modulus": "elasticity",
     "precompute": "tables", "Tables": "tables",
-    "conductivity": "conductivity",
     "squeeze_out": "squeeze", "squeeze_history": "squeeze", "squeeze_out_reduced": "reduced",
     "seal_leak": "seal", "seal_profile": "seal", "seal_elastic": "seal", "hertz_contact": "seal",
 }
@@ -34,7 +33,7 @@ __all__ = sorted(_LAZY) + ["__version__"]
 def __getattr__(name):
     if name in _LAZY:
         mod = importlib.import_module(f".{_LAZY[name]}", __name__)
-        return getattr(mod, name) if name != "conductivity" else mod
+        return getattr(mod, name)
     raise AttributeError(f"module 'fastcontact' has no attribute {name!r}")
 
 
