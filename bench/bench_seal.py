@@ -50,15 +50,11 @@ ALPHA = 0.54
 RATIOS = [1e-4, 1e-3, 1e-2, 0.1, 0.3, 0.5, 0.7, 0.9, 0.99, 0.999, 1.0]
 
 
+from machine_info import cpu_model  # noqa: E402  (bench/ is on sys.path when run)
+
+
 def machine():
-    model = "?"
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-        for line in out.splitlines():
-            if line.startswith("Model name"):
-                model = line.split(":", 1)[1].strip()
-    except OSError:
-        pass
+    model = cpu_model()
     import numba
 
     return (f"{model}, {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "

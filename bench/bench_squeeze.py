@@ -51,15 +51,11 @@ REF_PIS = {"average": [1e-9, 1e-5, 1e-2, 0.3, 1.5], "critical_junction": [1e-6, 
 KNOBS = [(3, 2.0), (4, 2.0), (6, 1.0), (8, 1.0), (10, 1.0), (16, 0.5), (20, 0.25)]
 
 
+from machine_info import cpu_model  # noqa: E402  (bench/ is on sys.path when run)
+
+
 def machine():
-    model = "?"
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-        for line in out.splitlines():
-            if line.startswith("Model name"):
-                model = line.split(":", 1)[1].strip()
-    except OSError:
-        pass
+    model = cpu_model()
     import numba
     return {"cpu": model, "cores": os.cpu_count(), "numba_threads": numba.get_num_threads(),
             "loadavg_start": os.getloadavg(),

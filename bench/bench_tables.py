@@ -19,7 +19,6 @@ import math
 import os
 import platform
 import statistics
-import subprocess
 import time
 from pathlib import Path
 
@@ -34,12 +33,11 @@ from fastcontact.tables import TOLERANCE, default_grid, precompute
 THEORIES = ("average", "critical_junction", "emt")
 
 
+from machine_info import cpu_model  # noqa: E402  (bench/ is on sys.path when run)
+
+
 def machine():
-    try:
-        model = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-        model = next((l.split(":", 1)[1].strip() for l in model.splitlines() if l.startswith("Model name")), "?")
-    except OSError:
-        model = platform.processor() or "?"
+    model = cpu_model()
     return f"{model}, {os.cpu_count()} cores, Python {platform.python_version()}, numpy {np.__version__}"
 
 

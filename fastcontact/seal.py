@@ -845,7 +845,6 @@ def seal_elastic(tables, *, R, f_N, dp, L_y, E_star, eta, theory="critical_junct
     n = int(check_range("n", n, 8, 5000, "[-] (panels)"))
     gap = float(check_positive("gap", gap, "[-] (multiples of h_rms)"))
     E, eta_, dpv, pb = com["E_star"], com["eta"], com["dp"], com["p_b"]
-    pa = pb + dpv
     sc = seal_context(tables, theory)
     h = sc.h_rms
     a, pH = (float(v) for v in hertz_contact(Rv, fN, E))

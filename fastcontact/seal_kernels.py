@@ -609,8 +609,8 @@ def panel_series(r, pan, P, n, Lp, coef, after):
 
 
 @njit(cache=True)
-def _interp_series(t, pan, P, n, coef, Pk):
-    """The panel-wise Legendre series (coef) at t."""
+def _panel_at(t, pan, P):
+    """(panel p with pan[p] <= t < pan[p+1], local Legendre variable z ∈ [-1, 1]) by bisection."""
     lo, hi = 0, P
     while hi - lo > 1:
         mid = (lo + hi) // 2
@@ -618,9 +618,13 @@ def _interp_series(t, pan, P, n, coef, Pk):
             lo = mid
         else:
             hi = mid
-    p = lo
-    hh = 0.5 * (pan[p + 1] - pan[p])
-    z = (t - pan[p]) / hh - 1.0
+    return lo, (t - pan[lo]) / (0.5 * (pan[lo + 1] - pan[lo])) - 1.0
+
+
+@njit(cache=True)
+def _interp_series(t, pan, P, n, coef, Pk):
+    """The panel-wise Legendre series (coef) at t."""
+    p, z = _panel_at(t, pan, P)
     _legendre_all(z, n, Pk)
     acc = 0.0
     for j in range(n):
@@ -635,21 +639,12 @@ def remaining_fraction(t, pan, P, n, coef, after, W, Pk):
         return 1.0
     if t >= 1.0:
         return 0.0
-    lo, hi = 0, P
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if pan[mid] <= t:
-            lo = mid
-        else:
-            hi = mid
-    p = lo
-    hh = 0.5 * (pan[p + 1] - pan[p])
-    z = (t - pan[p]) / hh - 1.0
+    p, z = _panel_at(t, pan, P)
     _legendre_all(z, n, Pk)
     acc = coef[p, 0] * (1.0 - z)
     for j in range(1, n):
         acc += coef[p, j] * (Pk[j - 1] - Pk[j + 1]) / (2 * j + 1)
-    return (after[p] + hh * acc) / W
+    return (after[p] + 0.5 * (pan[p + 1] - pan[p]) * acc) / W
 
 
 @njit(cache=True)
@@ -864,7 +859,6 @@ def solve_robust(ctx, kind, base, xg, pg, pmax, pia, pib, m, n, P0, PMAX, tol, m
         if lt == 1.0:
             pa = pia
         _zone_params(kind, base, xg, pg, pa, pib, gp)
-        last = lt == 1.0
         W2, st2, P2, est2, it2 = solve_case(ctx, kind, gp, xg, pg, pa, pib, m, n, P0, PMAX,
                                             tol, min(maxit, 25), zl, wl, At, Lp,
                                             pan_new, cc, rr, P, pan, sn, s_new)
