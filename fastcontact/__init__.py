@@ -19,12 +19,12 @@ import importlib
 __version__ = "0.1.0"
 
 _LAZY = {
-    "SelfAffinePSD": "psd", "TabulatedPSD": "psd", "PSD": "psd",
-    "read_psd": "topography", "write_psd": "topography", "psd_from_heights": "topography",
-    "synthetic_heights": "topography",
-    "effective_modulus": "elasticity",
+    "SelfAffinePSD": "surface.psd", "TabulatedPSD": "surface.psd", "PSD": "surface.psd",
+    "read_psd": "surface.topography", "write_psd": "surface.topography",
+    "psd_from_heights": "surface.topography", "synthetic_heights": "surface.topography",
+    "effective_modulus": "contact.elasticity",
     "precompute": "tables", "Tables": "tables",
-    "squeeze_out": "squeeze", "squeeze_history": "squeeze", "squeeze_out_reduced": "reduced",
+    "squeeze_out": "squeeze", "squeeze_history": "squeeze", "squeeze_out_reduced": "squeeze.reduced",
     "seal_leak": "seal", "seal_profile": "seal", "seal_elastic": "seal", "hertz_contact": "seal",
 }
 __all__ = sorted(_LAZY) + ["__version__"]

@@ -40,7 +40,7 @@ class _Parser(argparse.ArgumentParser):
 
 def _quantity(dim):
     def conv(text):
-        from .scene import parse_quantity
+        from .studies.scene import parse_quantity
         try:
             return parse_quantity("value", text, dim)
         except ValueError as exc:
@@ -125,7 +125,7 @@ def build_parser():
 
 # ============================================================================ commands
 def _cmd_run(a, out, err):
-    from .scene import example_scene_path, load_scene, run_scene
+    from .studies.scene import example_scene_path, load_scene, run_scene
     if a.default and a.scene:
         raise CLIError("fastcontact run: give a scene or --default, not both")
     if not a.default and not a.scene:
@@ -145,7 +145,7 @@ def _cmd_run(a, out, err):
 
 
 def _cmd_validate(a, out, err):
-    from .scene import load_scene
+    from .studies.scene import load_scene
     sc = load_scene(a.scene)
     n = len(sc.cases())
     print(f"{sc.source}: valid {sc.kind} scene, {len(sc.surfaces)} surface(s) x {n} case(s), "
@@ -154,7 +154,7 @@ def _cmd_validate(a, out, err):
 
 
 def _cmd_scenes(a, out, err):
-    from .scene import example_scene_path, list_example_scenes
+    from .studies.scene import example_scene_path, list_example_scenes
     if a.name:
         print(example_scene_path(a.name).read_text(), file=out, end="")
         return 0
@@ -182,7 +182,7 @@ def _cmd_tables_build(a, out, err):
         if a.convention is None:
             raise CLIError("fastcontact tables build: --psd needs --convention persson|"
                            "surface_topography")
-        from .topography import read_psd
+        from .surface.topography import read_psd
         psd = read_psd(a.psd, a.convention)
     else:
         missing = [k for k, v in sa.items() if v is None]
@@ -191,7 +191,7 @@ def _cmd_tables_build(a, out, err):
                            f"(or give --psd FILE --convention X)")
         if a.convention is not None:
             raise CLIError("fastcontact tables build: --convention is only used with --psd")
-        from .psd import SelfAffinePSD
+        from .surface.psd import SelfAffinePSD
         psd = SelfAffinePSD(a.h_rms, a.hurst, a.q0, a.q1, a.q_roll)
     if not str(a.output).endswith(".parquet"):
         raise CLIError(f"fastcontact tables build: -o {a.output!r} must end in .parquet")
@@ -258,7 +258,7 @@ def _cmd_tables_info(a, out, err):
 
 
 def _cmd_tables_defaults(a, out, err):
-    from .defaults import build_default_tables
+    from .tables.defaults import build_default_tables
     built = build_default_tables(a.output_dir)
     for name, t in built.items():
         e = t.info["interpolation_error"]
@@ -268,7 +268,7 @@ def _cmd_tables_defaults(a, out, err):
 
 
 def _cmd_sweep(a, out, err):
-    from .sweep import run_sweep
+    from .studies.sweep import run_sweep
     man = run_sweep(a.database, a.outdir, a.scene, scheduler=a.scheduler, workers=a.workers,
                     convention=a.convention, cache_dir=a.cache_dir,
                     progress=not a.no_progress, log=lambda m: print(m, file=err))
@@ -321,14 +321,14 @@ def _cmd_figures(a, out, err):
 
 
 def _cmd_roaddb_generate(a, out, err):
-    from .roaddb import generate_road_database, N_Q
+    from .surface.roaddb import generate_road_database, N_Q
     p = generate_road_database(a.path, a.n, a.seed, n_q=a.n_q or N_Q, convention=a.convention)
     print(f"wrote road database {p} ({a.n} surfaces, seed {a.seed})", file=out)
     return 0
 
 
 def _cmd_roaddb_info(a, out, err):
-    from .roaddb import open_road_database
+    from .surface.roaddb import open_road_database
     db = open_road_database(a.path, a.convention)
     import numpy as np
     h = []

@@ -6,7 +6,7 @@ from pathlib import Path
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ..atomic import atomic_path
+from .._core.io import atomic_path
 
 __all__ = ["new_figure", "save_png"]
 

@@ -36,7 +36,7 @@ import matplotlib.ticker
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from fastcontact.atomic import atomic_path
+from fastcontact._core.io import atomic_path
 
 __all__ = ["make_seal_figures", "seal_experiment", "EXPERIMENT"]
 
@@ -89,7 +89,7 @@ def _new_figure(**kw):
 def _tables(tables):
     if tables is not None:
         return tables
-    from fastcontact.defaults import load_default_tables
+    from fastcontact.tables.defaults import load_default_tables
 
     return load_default_tables(SURFACE)
 

@@ -43,12 +43,12 @@ def tire_curve(tables, *, p0, E_star, R, eta, theory="average", u_start=PAPER["u
     The time axis spans from well before the film starts to thin to 10× the last ratio time
     (or to 1e3× the first if the fluid is trapped).
     """
-    from fastcontact.reduced import flat_separation
+    from fastcontact.squeeze.reduced import flat_separation
     from fastcontact.squeeze import squeeze_history, squeeze_out
     sq = squeeze_out(tables, p0=p0, E_star=E_star, R=R, eta=eta, theory=theory, u_start=u_start,
                      ratios=tuple(ratios), du=(du,), times=(), method="quad")
     row = sq.iloc[0]
-    from fastcontact.tire import _pick
+    from fastcontact.squeeze.tire import _pick
     t_r = [float(row[c]) for c in _pick(sq, "t_ratio_", list(ratios))]
     t_du = float(row[_pick(sq, "t_du_", [du])[0]])
     u_inf = float(row["u_inf"])
@@ -135,11 +135,11 @@ def make_tire_figures(outdir, tables=None) -> list[Path]:
 
     ``tables``: optional {label: Tables}; default the embedded asphalt tables.
     """
-    from fastcontact.elasticity import effective_modulus
+    from fastcontact.contact.elasticity import effective_modulus
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     if tables is None:
-        from fastcontact.scene import default_table_path
+        from fastcontact.studies.scene import default_table_path
         from fastcontact.tables import Tables
         tables = {label: Tables.from_parquet(default_table_path(name)) for name, label in ROADS}
     E_star = effective_modulus(PAPER["E"], PAPER["nu"])

@@ -87,9 +87,9 @@ import numpy as np
 import pandas as pd
 from numba import njit, prange
 
-from ._validate import as_float_array, check_positive
-from .grids import build_bucket_map, locate_asc
-from .tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
+from .._core.validate import as_float_array, check_positive
+from ..kernels.locate import build_bucket_map, locate_asc
+from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
 
 __all__ = ["squeeze_out", "squeeze_history", "squeeze_model", "DEFAULT_P_START",
            "QUAD_ORDER", "QUAD_WIDTH", "FAST_DXI"]
@@ -648,7 +648,7 @@ def _fingerprint(tables):
 
 def squeeze_model(tables, theory="average", sigma_trap=None) -> SqueezeModel:
     """The cached :class:`SqueezeModel` of (tables, theory) — built on first use."""
-    from .tables import Tables
+    from ..tables import Tables
     if not isinstance(tables, Tables):
         raise ValueError(f"tables = {tables!r} is invalid: must be a fastcontact Tables "
                          f"(fastcontact.precompute(...) or Tables.from_parquet(...))")
@@ -721,7 +721,7 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory="average", u_start=None,
 
     ``DataFrame.attrs`` records the model decisions (trap criterion, tail, default start).
     """
-    from .tables import Tables
+    from ..tables import Tables
     if not isinstance(tables, Tables):
         raise ValueError(f"tables = {tables!r} is invalid: must be a fastcontact Tables")
     if method not in ("fast", "quad"):

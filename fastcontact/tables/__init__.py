@@ -40,14 +40,14 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from . import __version__
-from ._validate import check_positive, check_range
-from .conductivity import EMT_TOL, THEORIES, check_theory, sigma_bar
-from .contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
-from .atomic import atomic_path
-from .grids import (Grid, build_bucket_map, locate_asc, locate_desc,
+from .. import __version__
+from .._core.validate import check_positive, check_range
+from ..flow.conductivity import EMT_TOL, THEORIES, check_theory, sigma_bar
+from ..contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
+from .._core.io import atomic_path
+from ..kernels.locate import (Grid, build_bucket_map, locate_asc, locate_desc,
                     quintic_interval)
-from .psd import PSD, psd_from_dict
+from ..surface.psd import PSD, psd_from_dict
 
 __all__ = ["Tables", "precompute", "DEFAULT_POINTS_PER_DECADE", "SCHEMA_VERSION"]
 

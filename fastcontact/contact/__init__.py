@@ -22,11 +22,11 @@ import math
 import numpy as np
 from numba import njit
 
-from ._validate import check_positive, check_range
-from .psd import PSD
-from .quadrature import (PANEL, area_state, clip_at_kink, gauss_legendre, m3_from, psd_value, q_for_m3,
+from .._core.validate import check_positive, check_range
+from ..surface.psd import PSD
+from ._kernels import (PANEL, area_state, clip_at_kink, gauss_legendre, m3_from, psd_value, q_for_m3,
                          separation_integrals, u1_at)
-from .special import EULER_GAMMA, K_ZERO, erfinv, k_table
+from ..kernels.special import EULER_GAMMA, K_ZERO, erfinv, k_table
 
 __all__ = ["area_fraction", "mean_separation", "u1", "critical_magnification",
            "contact_pressure", "asymptote", "asymptote_self_affine", "stiffness_G",

@@ -90,8 +90,8 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pandas as pd
 
-from ._validate import as_float_array, check_positive, check_range
-from .conductivity import check_theory
+from .._core.validate import as_float_array, check_positive, check_range
+from ..flow.conductivity import check_theory
 
 __all__ = ["seal_leak", "seal_profile", "seal_elastic", "hertz_contact", "SOLVER_DEFAULTS",
            "seal_context"]
@@ -178,7 +178,7 @@ class SealContext:
     """
 
     def __init__(self, tables, theory):
-        from . import seal_kernels as sk
+        from . import _kernels as sk
 
         tables._need(theory)
         self.theory = theory
@@ -230,7 +230,7 @@ def seal_context(tables, theory) -> SealContext:
 
 # =========================================================================== validation
 def _check_tables(tables):
-    from .tables import Tables
+    from ..tables import Tables
 
     if not isinstance(tables, Tables):
         raise ValueError(f"tables = {tables!r} is invalid: must be a fastcontact Tables object "
@@ -322,7 +322,7 @@ def _require(kind, **given):
 # =========================================================================== uniform
 def _uniform_q_reduced(sc, c_lo, c_hi):
     """∫_{c_lo}^{c_hi} σ̄ dπ per row (reduced, contiguous arrays)."""
-    from . import seal_kernels as sk
+    from . import _kernels as sk
 
     out = np.empty(c_lo.size)
     _run_chunks(lambda a, b: sk.uniform_kernel(sc.ctx, sc.S, sc.sp, sc.glx, sc.glw, c_lo, c_hi,
@@ -398,7 +398,7 @@ EQUALITY_TOL = 1e-9
 def _solve_rows(sc, kind, xg, p0n, amp, pia, pib, o, keep=False):
     """Run the soft-seal row kernel (threads); returns W, status, panels, error, ξ_s, ξ_e
     (and, with keep, the single row's mesh and resistance density)."""
-    from . import seal_kernels as sk
+    from . import _kernels as sk
 
     n = int(o["nodes"])
     z, w, At, Lp = _gl(n)
@@ -667,7 +667,7 @@ def seal_profile(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory="criti
         open_ = np.isfinite(pf) & (p0o - pf <= 0.0)
         pc = np.where(open_, 0.0, p0o - pf)
     trapped = np.isnan(pf)
-    from . import seal_kernels as sk
+    from . import _kernels as sk
 
     cred = np.ascontiguousarray(np.where(trapped, 1.0, pc / E))
     sig = np.empty(n)
@@ -689,7 +689,7 @@ def seal_profile(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory="criti
 
 def _uniform_fluid(sc, p0, pa, pb, dp, E, frac_x, lift_off, percolated):
     """p_f at fractions x/L of a flat ring (inverting the primitive)."""
-    from . import seal_kernels as sk
+    from . import _kernels as sk
 
     n = frac_x.size
     if pa > p0:                       # open everywhere: the fluid stands at p_a up to the outlet
@@ -722,7 +722,7 @@ def _uniform_fluid(sc, p0, pa, pb, dp, E, frac_x, lift_off, percolated):
 
 def _general_fluid(sc, geo, pa, pb, dp, E, xo, row, o):
     """p_f at the output positions for a Hertz or array profile (solving once more)."""
-    from . import seal_kernels as sk
+    from . import _kernels as sk
 
     n_out = xo.size
     if bool(np.isinf(row.Q)):
@@ -835,7 +835,7 @@ def seal_elastic(tables, *, R, f_N, dp, L_y, E_star, eta, theory="critical_junct
     the profiles are those of the last converged step), ``dp_reached`` (the dp of the profiles),
     ``contact_load_fraction``, ``X``, ``a``, ``p_hertz_max``.
     """
-    from . import seal_kernels as sk
+    from . import _kernels as sk
 
     _check_tables(tables)
     alpha = _scalar("alpha_cj", _check_theory_for(tables, theory, alpha_cj, a_perc))

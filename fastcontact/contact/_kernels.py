@@ -30,7 +30,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .special import e1_and_exp, erfinv, k_eval
+from ..kernels.special import e1_and_exp, erfinv, k_eval
 
 #: default Gauss–Legendre order per panel and panel width in τ (see bench/bench_tables.py)
 GL_ORDER = 10

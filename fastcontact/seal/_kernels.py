@@ -53,7 +53,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
+from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
 
 # layout of ``ext``
 E_LNP_LO, E_LNP_HI, E_LNP_PERC, E_B0, E_B1, E_U_LO, E_CU, E_T0, E_H = range(9)

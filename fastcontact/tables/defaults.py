@@ -1,0 +1,88 @@
+"""The embedded default surfaces and their precomputed tables (issue #3, item 7).
+
+The paper's measured spectra are not published as data, so each surface is a documented
+**self-affine stand-in** with the paper's h_rms and parameters typical of its kind, chosen so
+that the paper's stated regimes hold:
+
+================  =======  ====  ==============  ==============  =======  =====================
+name              h_rms    H     q0 [1/m]        q_roll [1/m]    q1       why
+================  =======  ====  ==============  ==============  =======  =====================
+asphalt_072mm     0.72 mm  0.8   2π/5 cm         2π/8 mm         1e6      Sec. 5 road 1; ū > 2 h_rms at p0 = 0.2 MPa, E = 10 MPa
+asphalt_024mm     0.24 mm  0.8   2π/2 cm         2π/3 mm         1e6      Sec. 5 road 2; ū > 2 h_rms there too
+copper_012mm      0.12 mm  0.8   1150            (none)          1e6      Sec. 3; κ = p0/(βE*) = 1.48 and 10.3 at 0.2 and 1.4 MPa (paper: 1.5, 10.3), E = 2.3 MPa, ν = 0.5; percolates (A(ζ1)/A0 = 0.5) below 1.4 MPa
+pmma_34um         34 µm    0.8   2π/1 cm         2π/2 mm         1e7      Secs. 7–8 sand-blasted PMMA; ū ≈ 2 h_rms at p0 = 11.8 kPa
+================  =======  ====  ==============  ==============  =======  =====================
+
+All tables hold the three flow theories with the paper's defaults (γ = 1, a_perc = 0.5,
+α_cj = 1; the seal experiment rescales σ_cj by α_cj³ = 0.54³). Rebuild all of them with
+``fastcontact tables defaults`` (or :func:`build_default_tables`); the test-suite rebuilds
+them and compares with the shipped files.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+__all__ = ["DEFAULT_SURFACES", "default_surface", "default_table_path", "load_default_tables",
+           "build_default_tables"]
+
+DEFAULT_SURFACES = {
+    "asphalt_072mm": dict(h_rms=0.72e-3, hurst=0.8, q0=2 * math.pi / 0.05,
+                          q_roll=2 * math.pi / 0.008, q1=1e6),
+    "asphalt_024mm": dict(h_rms=0.24e-3, hurst=0.8, q0=2 * math.pi / 0.02,
+                          q_roll=2 * math.pi / 0.003, q1=1e6),
+    "copper_012mm": dict(h_rms=0.12e-3, hurst=0.8, q0=1150.0, q_roll=None, q1=1e6),
+    "pmma_34um": dict(h_rms=34e-6, hurst=0.8, q0=2 * math.pi / 0.01, q_roll=2 * math.pi / 0.002,
+                      q1=1e7),
+}
+DEFAULT_THEORIES = ("average", "critical_junction", "emt")
+
+PACKAGE_DATA = Path(__file__).resolve().parent.parent / "data"
+
+
+def _check_name(name):
+    if name not in DEFAULT_SURFACES:
+        raise ValueError(f"surface = {name!r} is invalid: the embedded defaults are "
+                         f"{sorted(DEFAULT_SURFACES)}")
+    return name
+
+
+def default_surface(name):
+    """The SelfAffinePSD stand-in of an embedded default surface."""
+    from ..surface.psd import SelfAffinePSD
+
+    return SelfAffinePSD(**DEFAULT_SURFACES[_check_name(name)])
+
+
+def default_table_path(name) -> Path:
+    """Path of the shipped Parquet tables of ``name`` (inside the installed package)."""
+    return PACKAGE_DATA / f"{_check_name(name)}.parquet"
+
+
+def load_default_tables(name):
+    """The shipped :class:`~fastcontact.tables.Tables` of an embedded default surface."""
+    from . import Tables
+
+    return Tables.from_parquet(default_table_path(name))
+
+
+def build_default_tables(outdirs=None, names=None):
+    """Rebuild the default tables and write them (atomically) to every folder in ``outdirs``.
+
+    Default folders: the package's ``fastcontact/data`` and, in a source checkout, the
+    repository's top-level ``tables/``. Returns {name: Tables}.
+    """
+    from . import precompute
+
+    if outdirs is None:
+        outdirs = [PACKAGE_DATA]
+        repo_tables = Path(__file__).resolve().parent.parent.parent / "tables"
+        if repo_tables.is_dir():
+            outdirs.append(repo_tables)
+    built = {}
+    for name in names or DEFAULT_SURFACES:
+        t = precompute(default_surface(name), theories=DEFAULT_THEORIES)
+        for d in outdirs:
+            t.to_parquet(Path(d) / f"{name}.parquet")
+        built[name] = t
+    return built
