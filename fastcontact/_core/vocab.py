@@ -21,11 +21,12 @@ CONVENTIONS = {"persson": 1.0, "surface_topography": 1.0 / (2.0 * 3.141592653589
 #: key of fastcontact's JSON block in Parquet key-value metadata
 METADATA_KEY = b"fastcontact"
 
-#: literature the engines implement: key -> (citation, DOI)
+#: literature the engines implement: key -> (citation, identifier); the identifier is a DOI
+#: ("10.…") or, where only the preprint could be confirmed, an arXiv number ("arXiv:…")
 REFERENCES = {
     "lorenz_persson_2010_squeeze": (
         "B. Lorenz and B.N.J. Persson, Time-dependent fluid squeeze-out between solids with "
-        "rough surfaces, Eur. Phys. J. E 32, 281 (2010)", "10.1140/epje/i2010-10626-9"),
+        "rough surfaces, Eur. Phys. J. E 32, 281 (2010)", "arXiv:1004.1037"),
     "persson_2001": (
         "B.N.J. Persson, Theory of rubber friction and contact mechanics, "
         "J. Chem. Phys. 115, 3840 (2001)", "10.1063/1.1388626"),
@@ -35,7 +36,7 @@ REFERENCES = {
         "10.1088/0953-8984/20/21/215214"),
     "lorenz_persson_2010_seals": (
         "B. Lorenz and B.N.J. Persson, Leak rate of seals: effective-medium theory and "
-        "comparison with experiment, Eur. Phys. J. E 31, 159 (2010)", "10.1140/epje/i2010-10558-6"),
+        "comparison with experiment, Eur. Phys. J. E 31, 159 (2010)", "arXiv:0911.3019"),
     "almqvist_2011": (
         "A. Almqvist, C. Campañá, N. Prodanov and B.N.J. Persson, Interfacial separation between "
         "elastic solids with randomly rough surfaces, J. Mech. Phys. Solids 59, 2355 (2011)",
@@ -50,7 +51,11 @@ REFERENCES = {
 def reference_list(keys=None) -> list[str]:
     """Citations with DOIs (all, or those named by ``keys``), as one string each."""
     keys = REFERENCES if keys is None else keys
-    return [f"{REFERENCES[k][0]}, doi:{REFERENCES[k][1]}" for k in keys]
+    out = []
+    for k in keys:
+        citation, ident = REFERENCES[k]
+        out.append(f"{citation}, {ident}" if ident.startswith("arXiv:") else f"{citation}, doi:{ident}")
+    return out
 
 
 def column_name(prefix: str, value) -> str:
