@@ -1,0 +1,39 @@
+"""Validation and calibration of the theories against a boundary-element reference (issue 13).
+
+- :func:`bem_reference` — random surfaces of a PSD, elastic contact (ContactMechanics) and
+  Reynolds flow on the gap field: A/A0, ū, σ_eff and the flow-stop pressure vs p0;
+- :func:`compare_theories` — every flow theory beside such a reference: relative errors of
+  A, ū, σ_eff, the flow-stop pressure and the propagated squeeze-out time;
+- :func:`calibrate` → :class:`Calibration` — joint fit of γ, α_cj, a_perc and the effective
+  medium's percolation threshold to a reference (or measured data);
+- :func:`emt_conductivity` — generalized (Kirkpatrick) Bruggeman medium with a threshold.
+
+The BEM needs ``pip install "fastcontact[bem]"``; comparison and calibration of an existing
+reference table do not. Submodules are imported lazily.
+"""
+from __future__ import annotations
+
+import importlib
+
+_LAZY = {
+    "bem_reference": "bem", "solve_contact": "bem", "surface_realization": "bem",
+    "BEMResolutionWarning": "bem",
+    "reynolds_conductivity": "reynolds",
+    "compare_theories": "compare", "squeeze_time_ratio": "compare",
+    "write_reference": "compare", "read_reference": "compare",
+    "calibrate": "calibrate", "Calibration": "calibrate",
+    "emt_conductivity": "emt", "emt_sigma_bar": "emt",
+    "comparison_figure": "figures",
+}
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        mod = importlib.import_module(f".{_LAZY[name]}", __name__)
+        return getattr(mod, name)
+    raise AttributeError(f"module 'fastcontact.validation' has no attribute {name!r}")
+
+
+def __dir__():
+    return __all__
