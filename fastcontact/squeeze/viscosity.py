@@ -1,0 +1,365 @@
+"""Squeeze-out with a pressure-dependent (Barus) viscosity η = η0 exp(α p_f) on the tables.
+
+The flat block of radius R squeezes a film of uniform mean separation ū (paper Secs. 2–3,
+eqs. 17–19). With η(p_f) the local flux is J = -(σ0/e^{α p_f}) ∇p_f = -σ0 ∇ψ, where σ0 is
+the conductivity at η0 and ψ = (1 - e^{-α p_f})/α is the reduced pressure. Mass
+conservation (dū/dt uniform) makes ψ parabolic, ψ = ψ0 (1 - r²/R²), ψ0 = -ū̇ R²/(4σ0), and
+the mean fluid pressure is a closed form of b = α ψ0 (docs/theory/extensions.md, §2):
+
+    α p̄_f = Φ(b) = 1 + (1 - b) ln(1 - b)/b,        Φ(b) → b/2 (α → 0), Φ(1) = 1.
+
+With the force balance p̄_f = p0 - p_cont(ū) (eq. 19) the squeeze rate becomes
+
+    dū/dt = -(8 σ0 / R²) (p0 - p_cont) g(a),   a = α (p0 - p_cont),   g(a) = Φ⁻¹(a)/(2a),
+
+i.e. the paper's rate (18)+(19) times a factor g ∈ (1/2, 1] (g = 1 - 2a/3 + O(a²)). So a
+rigid flat block at most *doubles* the squeeze-out time; for a ≥ 1 the fluid cannot carry
+the load at all (the Barus centre pressure diverges at b = 1 while p̄_f stays 1/α): the
+quasi-static rigid-block model fails there (elastohydrodynamic deformation or inertia take
+over) and such rows are flagged ``piezo_limit`` with NaN times — never a silent number.
+
+References: C. Barus, Am. J. Sci. 45, 87 (1893), doi:10.2475/ajs.s3-45.266.87;
+B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10628-1.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+from numba import njit, prange
+
+from .._core.validate import check_positive
+from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
+
+__all__ = ["barus_mean_pressure", "barus_rate_factor", "squeeze_out_piezo",
+           "DEFAULT_P_START"]
+
+#: default start, as in :func:`fastcontact.squeeze.squeeze_out`: p_cont(u_start) = 1e-3 p0
+DEFAULT_P_START = 1e-3
+ST_OK, ST_TRAPPED, ST_OUT, ST_PIEZO = 0, 1, 2, 3
+
+
+# =========================================================================== closed forms
+def barus_mean_pressure(psi0, alpha):
+    """Mean fluid pressure p̄_f [Pa] under the block for centre reduced pressure ψ0 [Pa].
+
+    ``p̄_f = [1 + (1 - b) ln(1 - b)/b]/α``, b = α ψ0 ∈ [0, 1) (ψ0 → p̄_f = ψ0/2 as α → 0).
+    """
+    psi0 = np.asarray(psi0, dtype=np.float64)
+    alpha = float(alpha)
+    if alpha == 0.0:
+        return 0.5 * psi0
+    b = alpha * psi0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        phi = 1.0 + (1.0 - b) * np.log1p(-b) / b
+        small = np.abs(b) < 1e-4
+        phi = np.where(small, b / 2 + b * b / 6 + b ** 3 / 12 + b ** 4 / 20, phi)
+    return np.where(b < 1.0, phi / alpha, np.nan)[()]
+
+
+@njit(cache=True)
+def _rate_factor(a):
+    """g(a) = Φ⁻¹(a)/(2a) for a = α p̄_f in [0, 1); NaN for a >= 1 (piezoviscous limit).
+
+    Φ(b) = 1 - c/expm1(c) with c = -ln(1 - b): solve c/expm1(c) = 1 - a by Newton in c.
+    """
+    if a < 0.0:
+        return math.nan
+    if a < 1e-5:
+        return 1.0 - 2.0 * a / 3.0 + 2.0 * a * a / 9.0
+    if a >= 1.0:
+        return math.nan
+    ly = math.log1p(-a)
+    lo = 0.0
+    hi = 800.0
+    c = 2.0 * a if a < 0.5 else -ly + math.log(max(-ly, 1.0)) + 1.0
+    for _ in range(200):
+        em = math.expm1(c)
+        h = math.log(c) - math.log(em) - ly          # decreasing in c
+        if h > 0.0:
+            lo = c
+        else:
+            hi = c
+        dh = 1.0 / c - (em + 1.0) / em
+        cn = c - h / dh
+        if not (lo < cn < hi):
+            cn = 0.5 * (lo + hi)
+        if abs(cn - c) <= 1e-15 * c:
+            c = cn
+            break
+        c = cn
+    b = -math.expm1(-c)
+    return b / (2.0 * a)
+
+
+@njit(cache=True)
+def _rate_factor_array(a, out):
+    for i in range(a.size):
+        out[i] = _rate_factor(a[i])
+
+
+def barus_rate_factor(a):
+    """Rate factor g(a) ∈ (1/2, 1] of the squeeze-out with a Barus fluid [-].
+
+    ``a = α_pv (p0 - p_cont)`` [-] is the Barus number of the mean fluid pressure; the
+    squeeze rate is the constant-viscosity rate times g (module docstring). NaN for a ≥ 1.
+    """
+    a = np.ascontiguousarray(np.asarray(a, dtype=np.float64))
+    out = np.empty(a.size)
+    _rate_factor_array(a.ravel(), out)
+    return out.reshape(a.shape)[()]
+
+
+# =========================================================================== kernels
+@njit(cache=True)
+def _state(tab, x_min, v_top, u0, lnsig_top, x_trap, v):
+    """(ln π_c, σ̄) at v = ū/h_rms; above the table top: eq. (3) tail and σ̄ ∝ v³."""
+    if v > v_top:
+        return x_min - (v - v_top) / u0, math.exp(lnsig_top) * (v / v_top) ** 3
+    lnp = k_lnp_of_lnu(tab, math.log(v))
+    if lnp >= x_trap:
+        return lnp, 0.0
+    return lnp, k_sigma_of_lnp(tab, lnp)
+
+
+@njit(cache=True)
+def _lnv_of_lnp(tab, x_min, v_top, u0, x):
+    """ln v with π_c(v) = e^x for the inverse interpolant (Newton on k_lnp_of_lnu)."""
+    if x <= x_min:
+        return math.log(v_top + u0 * (x_min - x))
+    y = k_lnu_of_lnp(tab, x)
+    hh = 1e-6
+    for _ in range(6):
+        f = k_lnp_of_lnu(tab, y) - x
+        fp = k_lnp_of_lnu(tab, y + hh)
+        fm = k_lnp_of_lnu(tab, y - hh)
+        if not (fp == fp and fm == fm):
+            break
+        slope = (fp - fm) / (2.0 * hh)
+        if not (slope < 0.0):
+            break
+        step = f / slope
+        y -= step
+        if abs(step) < 1e-15:
+            break
+    return y
+
+
+@njit(cache=True)
+def _integrand(tab, sc, x0, api, vinf, w):
+    """dt̃/dw at w = ln(v - v∞): (v - v∞)/(σ̄ d g(api d)), d = 1 - π_c/π0; 0 if σ̄ = 0."""
+    e = math.exp(w)
+    lnp, sig = _state(tab, sc[0], sc[1], sc[2], sc[3], sc[4], vinf + e)
+    if not (sig > 0.0):
+        return math.inf
+    d = -math.expm1(lnp - x0)
+    if d <= 1e-300:
+        d = 1e-300
+    g = _rate_factor(api * d) if api > 0.0 else 1.0
+    return e / (sig * d * g)
+
+
+@njit(cache=True)
+def _segment(tab, sc, x0, api, vinf, w1, w2, glx, glw, width):
+    if not (w2 > w1):
+        return 0.0
+    m = max(1, int(math.ceil((w2 - w1) / width)))
+    hw = (w2 - w1) / m
+    s = 0.0
+    for k in range(m):
+        mid = w1 + (k + 0.5) * hw
+        for j in range(glx.size):
+            s += 0.5 * hw * glw[j] * _integrand(tab, sc, x0, api, vinf, mid + 0.5 * hw * glx[j])
+    return s
+
+
+@njit(parallel=True, cache=True)
+def _piezo_kernel(tab, sc, p0, E, R, eta, alpha, us, h, vt_ratio, vt_dv, glx, glw, width,
+                  T, uinf, ustart, tau0, gstart, status):
+    """Per case: targets (ratios × v∞, then v∞ + dv) sorted downward, one pass (t̃ → SI)."""
+    nr = vt_ratio.size
+    nt = T.shape[0]
+    for i in prange(p0.size):
+        x0 = math.log(p0[i] / E[i])
+        tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
+        tau0[i] = tau
+        if not (sc[0] <= x0 <= sc[5]):
+            status[i] = ST_OUT
+            uinf[i] = math.nan
+            ustart[i] = us[i]
+            gstart[i] = math.nan
+            for k in range(nt):
+                T[k, i] = math.nan
+            continue
+        vinf = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0))
+        vs = us[i] / h
+        if vs != vs:
+            vs = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0 + math.log(DEFAULT_P_START)))
+        uinf[i] = vinf * h
+        ustart[i] = vs * h
+        api = alpha[i] * p0[i]
+        lnps, _s = _state(tab, sc[0], sc[1], sc[2], sc[3], sc[4], vs)
+        d_start = -math.expm1(lnps - x0)
+        gstart[i] = _rate_factor(api * d_start) if api > 0.0 else 1.0
+        status[i] = ST_TRAPPED if x0 >= sc[4] else ST_OK
+        if api * d_start >= 1.0:
+            status[i] = ST_PIEZO
+            for k in range(nt):
+                T[k, i] = math.nan
+            continue
+        vts = np.empty(nt)
+        for k in range(nt):
+            vts[k] = vt_ratio[k] * vinf if k < nr else vinf + vt_dv[k - nr]
+        order = np.argsort(-vts)
+        v_cur = vs
+        t_cur = 0.0
+        for kk in range(nt):
+            k = order[kk]
+            vt = vts[k]
+            if vt >= vs:
+                T[k, i] = 0.0
+                continue
+            if vt < v_cur:
+                t_cur += _segment(tab, sc, x0, api, vinf, math.log(vt - vinf),
+                                  math.log(v_cur - vinf), glx, glw, width)
+                v_cur = vt
+            T[k, i] = tau * t_cur
+
+
+# =========================================================================== model
+_SC_CACHE = {}
+
+
+def _scalars(tables, theory, sigma_trap):
+    """(x_min, v_top, u0, ln σ̄_top, x_trap, x_max) of (tables, theory) — the tail and trap."""
+    key = (id(tables), tables.surface.fingerprint(), theory, sigma_trap)
+    if key in _SC_CACHE:
+        return _SC_CACHE[key]
+    p_lo, p_hi = tables.p_range
+    x_min, x_max = math.log(p_lo), math.log(p_hi)
+    d = 1e-4
+    v = tables.mean_separation(np.array([p_lo, p_lo * math.exp(d)]), 1.0) / tables.h_rms
+    u0 = (v[0] - v[1]) / d
+    sig_top = float(tables.sigma_bar(p_lo, 1.0, theory))
+    floor = float(tables.info.get("sigma_floor", 1e-24) if sigma_trap is None else sigma_trap)
+    perc = tables.info["percolation_p_over_E"][theory]
+    x_trap = math.inf
+    if np.isfinite(perc):
+        hi = min(math.log(perc), x_max)
+        if float(tables.sigma_bar(math.exp(hi), 1.0, theory)) < floor:
+            lo = x_min
+            for _ in range(100):
+                mid = 0.5 * (lo + hi)
+                if float(tables.sigma_bar(math.exp(mid), 1.0, theory)) >= floor:
+                    lo = mid
+                else:
+                    hi = mid
+            x_trap = hi
+        elif math.log(perc) <= x_max:
+            x_trap = math.log(perc)
+    sc = np.array([x_min, v[0], u0, math.log(sig_top), x_trap, x_max])
+    _SC_CACHE[key] = sc
+    return sc
+
+
+def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory="average",
+                      u_start=None, ratios=(1.1, 1.01, 1.001), du=(), quad_order=10,
+                      quad_width=1.0, sigma_trap=None):
+    """Squeeze-out times of a flat block with a Barus fluid η = η0 exp(α_pv p_f) [s].
+
+    Parameters
+    ----------
+    tables : Tables
+        Precomputed tables of the rough surface holding ``theory``.
+    p0, E_star, R, eta : array_like
+        Squeezing pressure [Pa], effective modulus [Pa], block radius [m] and the viscosity
+        η0 at the outlet (ambient) pressure [Pa·s]; broadcast against each other.
+    alpha_pv : array_like
+        Pressure–viscosity coefficient α [1/Pa], >= 0 (0: the paper's constant viscosity).
+    theory : str
+        Flow theory of σ_eff ("average", "critical_junction", "emt").
+    u_start : array_like or None
+        Initial separation [m]; None: where p_cont = 1e-3 p0 (as :func:`squeeze_out`).
+    ratios, du : sequence
+        Targets ū/ū∞ > 1 (columns ``t_ratio_<r>``) and ū - ū∞ [m] (``t_du_<Δu>``).
+    quad_order, quad_width :
+        Gauss–Legendre order and panel width in w = ln(ū - ū∞) [-].
+    sigma_trap : float, optional
+        Reduced conductivity below which σ is treated as 0 (default the tables' floor).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Inputs, ``u_start``, ``u_inf`` [m], ``t_star`` (ū = 1.01 ū∞) and target times [s],
+        ``tau0`` [s], ``barus_number`` = α p0 [-], ``rate_factor_start`` g at the start [-],
+        flags ``piezo_limit`` (α(p0 - p_cont) >= 1 at the start: NaN times), ``trapped``
+        (p0 beyond the trap pressure: targets below ū_trap take inf), ``out_of_table``.
+
+    Notes
+    -----
+    Exact reduction of the radial Reynolds equation with η(p) (module docstring); the
+    time is the quadrature t = ∫ dū/|dū/dt| in ln(ū - ū∞) as in the base engine.
+    """
+    from ..tables import Tables
+    if not isinstance(tables, Tables):
+        raise ValueError(f"tables = {tables!r} is invalid: must be a fastcontact Tables")
+    tables._need(theory)
+    p0 = check_positive("p0", p0, "[Pa]")
+    E_star = check_positive("E_star", E_star, "[Pa]")
+    R = check_positive("R", R, "[m]")
+    eta = check_positive("eta", eta, "[Pa·s]")
+    alpha_pv = check_positive("alpha_pv", alpha_pv, "[1/Pa]", allow_zero=True)
+    us = np.array(np.nan) if u_start is None else check_positive("u_start", u_start, "[m]",
+                                                                    allow_inf=False)
+    ratios = np.atleast_1d(np.asarray(ratios, dtype=np.float64)).ravel()
+    if ratios.size and not np.all(np.isfinite(ratios) & (ratios > 1.0)):
+        raise ValueError(f"ratios = {ratios.tolist()!r} is invalid: every ratio must be a "
+                         f"finite number > 1 [-]")
+    du = np.atleast_1d(np.asarray(du, dtype=np.float64)).ravel()
+    if du.size:
+        check_positive("du", du, "[m]")
+    qo = int(quad_order)
+    if not 2 <= qo <= 64:
+        raise ValueError(f"quad_order = {quad_order!r} is invalid: must be an integer in [2, 64]")
+    width = float(check_positive("quad_width", quad_width, "[-]"))
+    shape = np.broadcast(p0, E_star, R, eta, alpha_pv, us).shape
+    flat = [np.ascontiguousarray(np.broadcast_to(a, shape).ravel(), dtype=np.float64)
+            for a in (p0, E_star, R, eta, alpha_pv, us)]
+    n = flat[0].size
+    h = float(tables.h_rms)
+    sc = _scalars(tables, theory, sigma_trap)
+    vr = np.ascontiguousarray(np.concatenate(([1.01], ratios)))
+    dv = np.ascontiguousarray(du / h)
+    T = np.empty((vr.size + dv.size, n))
+    uinf, ustart, tau0, gs = (np.empty(n) for _ in range(4))
+    status = np.empty(n, dtype=np.int8)
+    x, w = np.polynomial.legendre.leggauss(qo)
+    _piezo_kernel(tables.kernel_data(theory), sc, *flat, h, vr, dv, x, w, width, T, uinf,
+                  ustart, tau0, gs, status)
+    if u_start is not None:
+        bad = (status == ST_OK) & ~(flat[5] > uinf)
+        if np.any(bad):
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"u_start = {flat[5][i]!r} is invalid: must be > u_inf = "
+                             f"{uinf[i]!r} [m]")
+    cols = {"p0": flat[0], "E_star": flat[1], "R": flat[2], "eta": flat[3],
+            "alpha_pv": flat[4], "u_start": ustart, "u_inf": uinf, "t_star": T[0]}
+    for k, r in enumerate(ratios):
+        cols[f"t_ratio_{r:g}"] = T[1 + k]
+    for k, d in enumerate(du):
+        cols[f"t_du_{d:g}"] = T[1 + ratios.size + k]
+    cols.update({"tau0": tau0, "barus_number": flat[4] * flat[0], "rate_factor_start": gs,
+                 "piezo_limit": status == ST_PIEZO, "trapped": status == ST_TRAPPED,
+                 "out_of_table": status == ST_OUT})
+    df = pd.DataFrame(cols, copy=False)
+    units = {"p0": "Pa", "E_star": "Pa", "R": "m", "eta": "Pa s", "alpha_pv": "1/Pa",
+             "u_start": "m", "u_inf": "m", "tau0": "s", "barus_number": "1",
+             "rate_factor_start": "1"}
+    units.update({c: "s" for c in cols if c.startswith("t_")})
+    df.attrs.update({"units": units, "theory": theory, "viscosity": "Barus",
+                     "model": "dū/dt = -(8σ0/R²)(p0-p_cont) g(α(p0-p_cont)), "
+                              "g = Φ⁻¹(a)/(2a), Φ(b) = 1 + (1-b)ln(1-b)/b",
+                     "references": ["doi:10.2475/ajs.s3-45.266.87",
+                                    "doi:10.1140/epje/i2010-10628-1"]})
+    return df
