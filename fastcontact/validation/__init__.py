@@ -21,7 +21,7 @@ _LAZY = {
     "reynolds_conductivity": "reynolds",
     "compare_theories": "compare", "squeeze_time_ratio": "compare",
     "write_reference": "compare", "read_reference": "compare",
-    "calibrate": "calibrate", "Calibration": "calibrate",
+    "calibrate": "calibration", "Calibration": "calibration",
     "emt_conductivity": "emt", "emt_sigma_bar": "emt",
     "comparison_figure": "figures",
 }

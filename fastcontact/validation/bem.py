@@ -66,8 +66,10 @@ def require_extra():
 def _versions():
     import importlib.metadata as md
 
-    out = {}
-    for name in ("fastcontact", "ContactMechanics", "SurfaceTopography", "numpy", "scipy"):
+    from .. import __version__
+
+    out = {"fastcontact": __version__}
+    for name in ("ContactMechanics", "SurfaceTopography", "numpy", "scipy"):
         try:
             out[name] = md.version(name)
         except md.PackageNotFoundError:
