@@ -5,8 +5,8 @@ Lorenz–Persson flow theories (B. Lorenz & B.N.J. Persson, Eur. Phys. J. E 32, 
 doi:10.1140/epje/i2010-10626-9). For each random-phase realization of a power spectrum it
 
 1. synthesizes a periodic n×n height map whose periodogram equals C(q) at every lattice point
-   (Persson convention, h_rms² = 2π ∫ q C(q) dq; :func:`fastcontact.synthetic_heights` with
-   ``random_amplitudes=False``);
+   (Persson convention, h_rms² = 2π ∫ q C(q) dq; random phases nested across grids, so n and
+   2n grids of one seed carry the same surface — :func:`surface_realization`);
 2. solves frictionless, non-adhesive contact of that rigid rough surface with an elastic flat
    half-space of contact modulus E* at each nominal pressure p0 by the constrained conjugate
    gradient method of Polonsky & Keer (Wear 231, 206 (1999), doi:10.1016/S0043-1648(99)00113-1)
@@ -90,18 +90,54 @@ def _check_pos(name, value, unit):
     return v
 
 
+def _nested_uniform(n, seed):
+    """Uniform [0,1) numbers per lattice mode that do not depend on n for the modes n and 2n
+    share: the mode (i, j) (signed indices) takes its number from the smallest grid of the
+    chain n, n/2, n/4, … (down to an odd size or 8) that holds it, each grid with its own
+    generator ``default_rng([seed, size])``."""
+    sizes = [n]
+    while sizes[-1] % 2 == 0 and sizes[-1] // 2 >= 8:
+        sizes.append(sizes[-1] // 2)
+    i = np.fft.fftfreq(n, 1.0 / n).astype(np.int64)
+    I, J = np.meshgrid(i, i, indexing="ij")
+    out = np.empty((n, n))
+    done = np.zeros((n, n), dtype=bool)
+    for m in reversed(sizes):  # smallest first
+        inside = ~done & (np.abs(I) < m // 2 + (m % 2)) & (np.abs(J) < m // 2 + (m % 2))
+        if m % 2 == 0:  # the signed range of an even m×m grid is [-m/2, m/2)
+            inside &= (I >= -(m // 2)) & (I < m // 2) & (J >= -(m // 2)) & (J < m // 2)
+        r = np.random.default_rng([int(seed), int(m)]).random((m, m))
+        out[inside] = r[I[inside] % m, J[inside] % m]
+        done |= inside
+    return out
+
+
 def surface_realization(psd, n, box, seed):
     """One random-phase periodic realization h(x) [m] of ``psd`` on an n×n grid of side ``box``.
 
-    The periodogram equals C(|q|) at every lattice point q = 2π(i, j)/box (random phases only,
-    Persson convention): ``mean(h²) = Σ_{q≠0} C(q) (2π/box)²`` (Parseval), which tends to
-    ``psd.h_rms²`` when the lattice resolves the spectrum.
+    ``Z_k = (2π/a) √C(|q_k|) · n e^{iφ_k}``, ``h = Re ifft2(Z)`` (the normalisation of
+    :func:`fastcontact.synthetic_heights` with ``random_amplitudes=False``): the periodogram
+    equals C(|q|) at every lattice point q = 2π(i, j)/box (Persson convention), so
+    ``mean(h²) = Σ_{q≠0} C(q) (2π/box)²`` (Parseval), which tends to ``psd.h_rms²`` when the
+    lattice resolves the spectrum. The phases φ_k = 2π[(r_k - r_{-k}) mod 1] are uniform and
+    antisymmetric (a real map), with r_k from :func:`_nested_uniform`: the realizations of one
+    seed on n and 2n grids share every mode of the coarser grid, so a grid-convergence study
+    compares the *same* surface, the finer one adding only shorter wavelengths.
     """
-    from .. import synthetic_heights
-
     n = _check_int("n", n, 8)
     box = _check_pos("box", box, "[m]")
-    return synthetic_heights(psd, n, box / n, seed=seed, random_amplitudes=False)
+    seed = _check_int("seed", seed, 0)
+    a = box / n
+    r = _nested_uniform(n, seed)
+    idx = (-np.arange(n)) % n
+    phi = 2.0 * math.pi * np.mod(r - r[idx][:, idx], 1.0)
+    q1d = 2.0 * math.pi * np.fft.fftfreq(n, a)
+    qk = np.hypot(q1d[:, None], q1d[None, :])
+    for edge in (psd.q0, psd.q1):  # a lattice point equal to q0 or q1 up to round-off
+        qk[np.abs(qk / edge - 1.0) < 1e-9] = edge
+    filt = (2.0 * math.pi / a) * np.sqrt(np.asarray(psd(qk), dtype=np.float64))
+    filt[0, 0] = 0.0
+    return np.fft.ifft2(n * np.exp(1j * phi) * filt).real
 
 
 def resolution_report(psd, n, box):
@@ -264,7 +300,7 @@ def bem_reference(psd, E_star, p0, *, n=256, seeds=(0, 1, 2), eta=1e-3, box=None
         ``n_flowing`` (seeds with σ > 0) and, with ``grid_check``, ``*_grid_err``.
         ``attrs`` hold ``units``, ``eta``, ``E_star``, ``flow_stop_pressure`` [Pa] (mean over
         seeds; NaN if flow never stops in the range), ``flow_stop_pressure_std``,
-        ``flow_stop_per_seed``, ``provenance`` (grid, seeds, box, pixel, psd, versions,
+        ``flow_stop_per_seed``, ``per_seed`` (each seed's columns), ``provenance`` (grid, seeds, box, pixel, psd, versions,
         resolution, timing) and ``warnings``.
     """
     import pandas as pd
@@ -372,6 +408,11 @@ def bem_reference(psd, E_star, p0, *, n=256, seeds=(0, 1, 2), eta=1e-3, box=None
         "flow_stop_pressure": stop_mean,
         "flow_stop_pressure_std": stop_std,
         "flow_stop_per_seed": {str(s): stops[int(s)][0] for s in seeds},
+        "per_seed": {str(s): {"area_fraction": results[(n, s)][:, 0].tolist(),
+                              "u_mean": results[(n, s)][:, 1].tolist(),
+                              "sigma_eff": (0.5 * (results[(n, s)][:, 2]
+                                                   + results[(n, s)][:, 3])).tolist()}
+                     for s in seeds},
         "flow_stop_log_bracket": max((stops[int(s)][1] for s in seeds if
                                       np.isfinite(stops[int(s)][1])), default=math.nan),
         "provenance": {

@@ -187,8 +187,10 @@ def _clip_log(th, ref):
     return np.clip(r, -CLIP, CLIP)
 
 
-def residuals(psd, E_star, reference, params):
-    """Residual groups (dict of arrays) of the constants ``params`` against ``reference``."""
+def residuals(psd, E_star, reference, params, theories=("critical_junction", "emt")):
+    """Residual groups (dict of arrays) of the constants ``params`` against ``reference``.
+
+    ``theories`` selects the flow theories whose σ_eff and flow stop enter."""
     from .. import contact
     from .compare import theory_flow_stop, theory_sigma
 
@@ -215,11 +217,15 @@ def residuals(psd, E_star, reference, params):
         n_sig = max(int(flow.sum()), 1)
         if flow.any():
             for key, th in (("sigma_cj", "critical_junction"), ("sigma_emt", "emt")):
+                if th not in theories:
+                    continue
                 s_th = theory_sigma(psd, p[flow], E_star, eta, th, **prm)
                 out[key] = _clip_log(s_th, s_ref[flow])
     if np.isfinite(stop_ref) and stop_ref > 0:
         w = math.sqrt(n_sig)
         for key, th in (("stop_cj", "critical_junction"), ("stop_emt", "emt")):
+            if th not in theories:
+                continue
             out[key] = np.array([w * math.log(theory_flow_stop(psd, E_star, th, **prm) / stop_ref)])
     return out
 
@@ -228,21 +234,24 @@ def _rms(groups):
     return {k: float(np.sqrt(np.mean(v ** 2))) if v.size else math.nan for k, v in groups.items()}
 
 
-def _which(reference):
+def _which(reference, theories):
     have_u = "u_mean" in reference
     have_s = "sigma_eff" in reference and bool((reference["sigma_eff"] > 0).any())
     have_stop = np.isfinite(float(reference.attrs.get("flow_stop_pressure", math.nan)))
     fit = []
     if have_u or have_s:
         fit.append("gamma")
-    if have_s:
+    if have_s and "critical_junction" in theories:
         fit.append("alpha_cj")
-    if have_s or have_stop:
-        fit += ["a_perc", "emt_threshold"]
+    if (have_s or have_stop) and "critical_junction" in theories:
+        fit.append("a_perc")
+    if (have_s or have_stop) and "emt" in theories:
+        fit.append("emt_threshold")
     return fit
 
 
-def calibrate(psd, E_star, reference, *, fit=None, initial=None):
+def calibrate(psd, E_star, reference, *, fit=None, initial=None,
+              theories=("critical_junction", "emt")):
     """Fit γ, α_cj, a_perc and the Bruggeman threshold jointly to a reference.
 
     Parameters
@@ -260,6 +269,8 @@ def calibrate(psd, E_star, reference, *, fit=None, initial=None):
         constrains. The others stay at ``initial`` or their defaults.
     initial : dict, optional
         Starting values (defaults γ = 1, α_cj = 1, a_perc = 0.5, threshold = 0.5).
+    theories : sequence of {"critical_junction", "emt"}
+        Flow theories whose σ_eff and flow stop enter the fit (default both).
 
     Returns
     -------
@@ -279,11 +290,16 @@ def calibrate(psd, E_star, reference, *, fit=None, initial=None):
     if "p0" not in reference or len(reference) == 0:
         raise ValueError("reference is invalid: it needs a non-empty 'p0' column [Pa]")
     start = dict(DEFAULTS) | dict(initial or {})
-    names = list(_which(reference) if fit is None else fit)
+    theories = tuple(theories)
+    for th in theories:
+        if th not in ("critical_junction", "emt"):
+            raise ValueError(f"theories entry {th!r} is invalid: must be 'critical_junction' "
+                             f"or 'emt'")
+    names = list(_which(reference, theories) if fit is None else fit)
     for nme in names:
         if nme not in PARAMETERS:
             raise ValueError(f"fit entry {nme!r} is invalid: must be one of {list(PARAMETERS)}")
-    before = residuals(psd, E_star, reference, DEFAULTS)
+    before = residuals(psd, E_star, reference, DEFAULTS, theories)
     if not before:
         raise ValueError("reference is invalid: it has none of 'u_mean', 'sigma_eff', "
                          "attrs['flow_stop_pressure'] to fit to")
@@ -292,7 +308,7 @@ def calibrate(psd, E_star, reference, *, fit=None, initial=None):
     x0 = np.clip(np.array([start[k] for k in names], dtype=float), lo + 1e-9, hi - 1e-9)
 
     def vec(x):
-        g = residuals(psd, E_star, reference, start | dict(zip(names, x)))
+        g = residuals(psd, E_star, reference, start | dict(zip(names, x)), theories)
         return np.concatenate([v for v in g.values()])
 
     sol = None
@@ -302,11 +318,11 @@ def calibrate(psd, E_star, reference, *, fit=None, initial=None):
                             x_scale=np.maximum(np.abs(x0), 0.1), xtol=1e-8, ftol=1e-10,
                             max_nfev=400)
         final |= dict(zip(names, (float(v) for v in sol.x)))
-    after = residuals(psd, E_star, reference, final)
+    after = residuals(psd, E_star, reference, final, theories)
     prov = {"reference": reference.attrs.get("provenance", {}),
             "reference_flow_stop_pressure": reference.attrs.get("flow_stop_pressure"),
             "E_star": E_star, "eta": float(reference.attrs.get("eta", 1e-3)),
-            "n_pressures": int(len(reference)),
+            "n_pressures": int(len(reference)), "theories": list(theories),
             "least_squares": None if sol is None else {"cost": float(sol.cost),
                                                        "nfev": int(sol.nfev),
                                                        "status": int(sol.status)}}
