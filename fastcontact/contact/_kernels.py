@@ -1,11 +1,12 @@
-"""Numba quadrature of Persson's contact mechanics (App. A of the paper, SPEC §2).
+"""Numba quadrature of Persson's contact mechanics (App. A of Lorenz & Persson 2010).
 
-The spectrum enters as the piecewise power-law arrays ``(qb, c, e, cum3)`` of
-:meth:`fastcontact.psd.PSD.kernel_arrays`; pressures are reduced, ``P = p/E*``.
+The spectrum enters as a flat :class:`PSDKernel` record (the piecewise power-law arrays
+``(qb, c, e, cum3)`` of :meth:`fastcontact.surface.psd.PSD.kernel_arrays` and the sorted
+kinks); pressures are reduced, ``P = p/E*``.
 
 Integrals over q in (A4) and its derivatives are taken in the variable
 ``τ = ln((q - a)/a)`` (``a = ζ q0``, the lower limit), i.e. ``q = a(1 + e^τ)``. This resolves
-the ``(q - a)^{-1/2}`` divergence of ``w(q, ζ)`` at the lower limit (SPEC §2 trap) at every
+the ``(q - a)^{-1/2}`` divergence of ``w(q, ζ)`` at the lower limit at every
 pressure: in τ the integrands decay exponentially on both sides. ``∫_a^q q'³C dq'`` is
 evaluated in closed form from ``q - a`` (``expm1``/``log1p``), free of cancellation.
 Composite Gauss–Legendre panels of width ``PANEL`` in τ, with panel boundaries at the
@@ -22,18 +23,28 @@ and ``I_g' = dI_g/d ln P = √π ∫ q²C w s0 g'(s0) dq`` (so d²ū/d(ln p)² =
 with ``F(s) = (γ/2) E1(s²) + 3(1-γ) K(s)`` and ``g(s) = [γ + 3(1-γ) erf²(s)] e^{-s²}``
 (γ = 1 is the paper's A4; the Yang–Persson correction otherwise), so that (A3) becomes
 ``u1(ζ) = I_F + I_g + k(ζ) (A/A') J`` with ``k = (π/2) q0 (ζq0)³ C(ζq0)``.
+
+References: B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010),
+doi:10.1140/epje/i2010-10626-9; C. Yang and B.N.J. Persson, J. Phys.: Condens. Matter 20,
+215214 (2008), doi:10.1088/0953-8984/20/21/215214.
 """
 from __future__ import annotations
 
 import math
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
+from ..kernels.quadrature import GL_ORDER, gauss_legendre, seg_moment as _seg_moment
 from ..kernels.special import e1_and_exp, erfinv, k_eval
 
-#: default Gauss–Legendre order per panel and panel width in τ (see bench/bench_tables.py)
-GL_ORDER = 10
+__all__ = ["PSDKernel", "psd_kernel", "GL_ORDER", "PANEL", "gauss_legendre", "separation_integrals",
+           "area_state", "u1_at", "u1_at_area", "m1_above", "m3_between", "q_for_m3",
+           "mean_separation_kernel", "u1_kernel", "contact_pressure_kernel", "asymptote_kernel"]
+
+#: panel width in τ (see bench/bench_tables.py); GL_ORDER nodes per panel
 PANEL = 1.0
 #: s0² above which the integrands are negligible (e^{-64} ~ 1.6e-28)
 S2_CUT = 64.0
@@ -45,9 +56,35 @@ TAU_FLOOR = -300.0
 SQRT_PI = math.sqrt(math.pi)
 
 
-def gauss_legendre(n=GL_ORDER):
-    x, w = np.polynomial.legendre.leggauss(n)
-    return np.ascontiguousarray(x), np.ascontiguousarray(w)
+class PSDKernel(NamedTuple):
+    """A spectrum as plain arrays for the kernels (Persson convention, SI).
+
+    Attributes
+    ----------
+    qb : ndarray
+        Segment boundaries q0 = qb[0] < ... < qb[-1] = q1 [1/m].
+    c : ndarray
+        C(q) at each segment start [m⁴].
+    e : ndarray
+        Power-law exponent of each segment [-].
+    cum3 : ndarray
+        ∫_{q0}^{qb[i]} q³ C dq at the boundaries [1/m²].
+    kinks : ndarray
+        Sorted wavenumbers where C(q) has a kink (panel breaks) [1/m].
+    """
+
+    qb: np.ndarray
+    c: np.ndarray
+    e: np.ndarray
+    cum3: np.ndarray
+    kinks: np.ndarray
+
+
+def psd_kernel(psd) -> PSDKernel:
+    """The :class:`PSDKernel` record of a :class:`~fastcontact.surface.psd.PSD`."""
+    qb, c, e, cum3 = psd.kernel_arrays()
+    kinks = np.ascontiguousarray(np.sort(np.asarray(psd.kinks, dtype=np.float64)))
+    return PSDKernel(qb, c, e, cum3, kinks)
 
 
 @njit(cache=True)
@@ -63,18 +100,9 @@ def seg_index(qb, q):
 
 @njit(cache=True)
 def psd_value(qb, c, e, q):
+    """C(q) [m⁴] of the piecewise power law."""
     i = seg_index(qb, q)
     return c[i] * (q / qb[i]) ** e[i]
-
-
-@njit(cache=True)
-def _seg_moment(ci, qs, ei, n, a, lr):
-    """∫_a^{a e^{lr}} q^n ci (q/qs)^ei dq, cancellation-free for small lr."""
-    k = n + ei + 1.0
-    pref = ci * (a / qs) ** ei * a ** (n + 1.0)
-    if abs(k) < 1e-12:
-        return pref * lr
-    return pref * math.expm1(k * lr) / k
 
 
 @njit(cache=True)
@@ -172,11 +200,13 @@ def f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder):
 
 
 @njit(cache=True)
-def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, panel, out):
+def separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, out):
     """(I_F, I_g, J, I_g') for lower limit ``a`` [1/m] and reduced pressure P into out[0:4] [m].
 
-    ``I_g' = √π ∫ q²C w s0 g'(s0) dq = dI_g/d ln P``, so ``d²ū/d(ln p)² = -I_g'``.
+    ``sk`` is a :class:`PSDKernel`; ``I_g' = √π ∫ q²C w s0 g'(s0) dq = dI_g/d ln P``, so
+    ``d²ū/d(ln p)² = -I_g'``.
     """
+    qb, c, e, cum3, kinks = sk
     kt0, kdt, kval, kder, rdt, rval, rder = ktab
     out[0] = 0.0
     out[1] = 0.0
@@ -265,11 +295,12 @@ def separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, pan
 
 
 @njit(cache=True)
-def area_state(qb, c, e, cum3, a, pbar):
+def area_state(sk, a, pbar):
     """(A(ζ)/A0, A/A' [ζ units], P = p(ζ)/E*) at lower limit a = ζ q0 (A1, A2 of the paper).
 
     A/A' is -inf where dA/dζ underflows (ζ = 1, or p/(2√G) > 26): u1 is undefined there.
     """
+    qb, c, e, cum3 = sk.qb, sk.c, sk.e, sk.cum3
     q0 = qb[0]
     if a <= q0:
         return 1.0, -math.inf, pbar
@@ -286,22 +317,23 @@ def area_state(qb, c, e, cum3, a, pbar):
 
 
 @njit(cache=True)
-def u1_at(qb, c, e, cum3, kinks, a, pbar, gamma, ktab, glx, glw, panel, work):
+def u1_at(sk, a, pbar, gamma, ktab, glx, glw, panel, work):
     """u1(ζ) [m] (A3) at a = ζq0 for reduced nominal pressure pbar; inf where masked."""
-    A, ratio, P = area_state(qb, c, e, cum3, a, pbar)
+    A, ratio, P = area_state(sk, a, pbar)
     if not (ratio > -math.inf) or A <= 0.0:
         return math.inf
-    separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, panel, work)
-    k = 0.5 * math.pi * qb[0] * a ** 3 * psd_value(qb, c, e, a)
+    separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, work)
+    k = 0.5 * math.pi * sk.qb[0] * a ** 3 * psd_value(sk.qb, sk.c, sk.e, a)
     return work[0] + work[1] + k * ratio * work[2]
 
 
 @njit(cache=True)
-def u1_at_area(qb, c, e, cum3, kinks, area, pbar, gamma, ktab, glx, glw, panel, work):
+def u1_at_area(sk, area, pbar, gamma, ktab, glx, glw, panel, work):
     """u1 [m] at the magnification where A(ζ)/A0 = area (exact, no ζ round-off).
 
     Returns (u1, a = ζ q0). ``area`` must be in (A(ζ1)/A0, 1).
     """
+    qb, c, e, cum3 = sk.qb, sk.c, sk.e, sk.cum3
     x = erfinv(area)
     G = (pbar / (2.0 * x)) ** 2
     target = 4.0 * G / math.pi
@@ -309,6 +341,88 @@ def u1_at_area(qb, c, e, cum3, kinks, area, pbar, gamma, ktab, glx, glw, panel, 
     gp_over_g = qb[0] * a ** 3 * psd_value(qb, c, e, a) / target
     ratio = -SQRT_PI * area * math.exp(x * x) / (x * gp_over_g)
     P = pbar / area
-    separation_integrals(qb, c, e, cum3, kinks, a, P, gamma, ktab, glx, glw, panel, work)
+    separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, work)
     k = 0.5 * math.pi * qb[0] * a ** 3 * psd_value(qb, c, e, a)
     return work[0] + work[1] + k * ratio * work[2], a
+
+
+# --------------------------------------------------------------------------- drivers
+@njit(cache=True)
+def mean_separation_kernel(sk, pbar, zeta, gamma, ktab, glx, glw, panel, out, dout, d2out):
+    """ū(ζ) [m], dū/d ln p [m] and d²ū/d(ln p)² [m] per (reduced pressure, ζ) (A4)."""
+    work = np.empty(4)
+    q0 = sk.qb[0]
+    for i in range(pbar.size):
+        a = zeta[i] * q0
+        A, ratio, P = area_state(sk, a, pbar[i])
+        separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, work)
+        out[i] = work[0]
+        dout[i] = -work[1]
+        d2out[i] = -work[3]
+
+
+@njit(cache=True)
+def u1_kernel(sk, pbar, zeta, gamma, ktab, glx, glw, panel, out):
+    """u1(ζ) [m] per (reduced pressure, ζ) (A3); inf where dA/dζ underflows."""
+    work = np.empty(4)
+    q0 = sk.qb[0]
+    for i in range(pbar.size):
+        out[i] = u1_at(sk, zeta[i] * q0, pbar[i], gamma, ktab, glx, glw, panel, work)
+
+
+@njit(cache=True)
+def contact_pressure_kernel(sk, ubar, lnp_guess, gamma, ktab, glx, glw, panel, out):
+    """Solve ū(p) = u for ln p̄ by safeguarded Newton (ū decreasing, dū/d ln p = -I_g)."""
+    work = np.empty(4)
+    q0 = sk.qb[0]
+    for i in range(ubar.size):
+        target = ubar[i]
+        lo = -745.0
+        hi = 50.0
+        x = lnp_guess[i]
+        if x < lo or x > hi:
+            x = 0.5 * (lo + hi)
+        for it in range(200):
+            separation_integrals(sk, q0, math.exp(x), gamma, ktab, glx, glw, panel, work)
+            f = work[0] - target
+            if f > 0.0:
+                lo = x
+            else:
+                hi = x
+            d = -work[1]
+            step = f / d if d < 0.0 else 0.0
+            xn = x - step
+            if not (lo < xn < hi) or d >= 0.0:
+                xn = 0.5 * (lo + hi)
+            if abs(xn - x) < 1e-14 * max(1.0, abs(x)) or hi - lo < 1e-14:
+                x = xn
+                break
+            x = xn
+        out[i] = x
+
+
+@njit(cache=True)
+def asymptote_kernel(sk, glx, glw, panel):
+    """(√π ∫ q²C w dq [m], ∫ q²C w ln w dq / ∫ q²C w dq) at ζ = 1 (small-p limit of A4)."""
+    qb, c, e, cum3, kinks = sk
+    a = qb[0]
+    ia = 0
+    tau_hi = math.log(qb[-1] / a - 1.0)
+    t0 = -120.0
+    s0 = 0.0
+    s1 = 0.0
+    ik = 0
+    while t0 < tau_hi:
+        t1, ik = clip_at_kink(kinks, ik, a, qb[-1], t0, min(t0 + panel, tau_hi))
+        half = 0.5 * (t1 - t0)
+        mid = 0.5 * (t1 + t0)
+        for j in range(glx.size):
+            tau = mid + half * glx[j]
+            delta = math.exp(tau)
+            q = a * (1.0 + delta)
+            w = 1.0 / math.sqrt(math.pi * m3_from(qb, c, e, cum3, a, ia, delta))
+            wt = glw[j] * half * a * delta * q * q * psd_value(qb, c, e, q) * w
+            s0 += wt
+            s1 += wt * math.log(w)
+        t0 = t1
+    return math.sqrt(math.pi) * s0, s1 / s0

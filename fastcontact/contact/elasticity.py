@@ -1,4 +1,4 @@
-"""Elastic moduli (SPEC §2)."""
+"""Elastic moduli: the effective modulus E* of one or two elastic solids."""
 from __future__ import annotations
 
 import numpy as np

@@ -1,1 +1,1 @@
-"""fastcontact.flow."""
+"""Interfacial fluid flow conductivity: :mod:`.conductivity` (wrappers), :mod:`._kernels`."""

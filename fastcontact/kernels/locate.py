@@ -4,9 +4,8 @@ A grid is the triple ``(log10_min, log10_max, n)``; node i sits at
 ``10**(log10_min + i (log10_max - log10_min)/(n - 1))``. The same triple is written to
 the Parquet metadata. Kernels work in natural logs: ``ln x_i = ln_lo + i * dln``.
 
-Interpolation is quintic Hermite with *exact* first and second derivatives stored beside
-the values (derivatives with respect to ln x), error O(h⁶). Every lookup reports whether
-its argument was inside the table; nothing is extrapolated silently.
+Every lookup reports whether its argument was inside the table (-1 outside); nothing is
+extrapolated silently. (The quintic Hermite interpolant lives in :mod:`.hermite`.)
 
 Inverse lookups (contact pressure from separation) use the same nodes: ln ū is monotone
 on the pressure grid, and a uniform bucket map over -ln ū finds the interval in O(1).
@@ -18,6 +17,8 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+
+from .hermite import quintic_interval  # noqa: F401  (re-export, old home)
 
 __all__ = ["Grid", "quintic_interval", "build_bucket_map", "locate_desc",
            "locate_asc"]
@@ -34,37 +35,25 @@ class Grid(NamedTuple):
 
     @property
     def ln_lo(self) -> float:
+        """ln of the first node."""
         return self.log10_min * LN10
 
     @property
     def dln(self) -> float:
+        """Node spacing in ln x."""
         return (self.log10_max - self.log10_min) * LN10 / (self.n - 1)
 
     def nodes(self) -> np.ndarray:
+        """The n nodes 10**linspace(log10_min, log10_max, n)."""
         return 10.0 ** np.linspace(self.log10_min, self.log10_max, self.n)
 
     def ln_nodes(self) -> np.ndarray:
+        """The n nodes in natural log, ln_lo + i dln."""
         return self.ln_lo + self.dln * np.arange(self.n)
 
     def to_list(self):
+        """[log10_min, log10_max, n] as plain Python numbers (JSON metadata)."""
         return [float(self.log10_min), float(self.log10_max), int(self.n)]
-
-
-@njit(cache=True)
-def quintic_interval(x, x0, x1, y0, y1, d0, d1, s0, s1):
-    """Quintic Hermite on [x0, x1] with values y, first derivatives d and second s."""
-    h = x1 - x0
-    t = (x - x0) / h
-    t2 = t * t
-    t3 = t2 * t
-    t4 = t3 * t
-    t5 = t4 * t
-    return ((1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5) * y0
-            + (t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5) * h * d0
-            + 0.5 * (t2 - 3.0 * t3 + 3.0 * t4 - t5) * h * h * s0
-            + (10.0 * t3 - 15.0 * t4 + 6.0 * t5) * y1
-            + (-4.0 * t3 + 7.0 * t4 - 3.0 * t5) * h * d1
-            + 0.5 * (t3 - 2.0 * t4 + t5) * h * h * s1)
 
 
 def build_bucket_map(y_desc, n_buckets=None, ascending=False):

@@ -4,8 +4,8 @@ All kernels are ``@njit(cache=True)`` and compile on first use, never at import.
 
 - :func:`e1` — exponential integral E1(x), series for x <= 1, Lentz continued fraction
   above; relative error <= 2e-14 against ``scipy.special.exp1`` on 1e-14 <= x <= 700.
-- :func:`k_table` / :func:`k_eval` — K(s0) = ∫_{s0}^∞ erf²(s) e^{-s²} ds / s (SPEC §2,
-  Yang–Persson correction), a cubic Hermite table in ln s0 with exact derivatives
+- :func:`k_table` / :func:`k_eval` — K(s0) = ∫_{s0}^∞ erf²(s) e^{-s²} ds / s (the
+  Yang–Persson correction, doi:10.1088/0953-8984/20/21/215214), a cubic Hermite table in ln s0 with exact derivatives
   dK/d(ln s0) = -erf²(s0) e^{-s0²}, with the series below the table and
   E1(s0²)/2 above it; K(0) = 0.4071249346.
 """
@@ -13,9 +13,17 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
+import scipy.special as sp
 from numba import njit
+from scipy.integrate import quad
+
+from .hermite import cubic_uniform
+from .quadrature import gauss_legendre
+
+__all__ = ["EULER_GAMMA", "K_ZERO", "KTable", "e1", "e1_and_exp", "erfinv", "k_eval", "k_table"]
 
 EULER_GAMMA = 0.57721566490153286061
 
@@ -71,15 +79,22 @@ def e1(x):
     return e1_and_exp(x)[0]
 
 
-_GL12_X, _GL12_W = np.polynomial.legendre.leggauss(12)
+class KTable(NamedTuple):
+    """The K(s0) Hermite tables: direct K on t = ln s0 in [tmin, 0], ratio ρ = 2K/E1(s0²) above."""
+
+    tmin: float
+    dt: float
+    kval: np.ndarray
+    kder: np.ndarray
+    dtr: float
+    rval: np.ndarray
+    rder: np.ndarray
 
 
 @lru_cache(maxsize=1)
-def k_table():
+def k_table() -> KTable:
     """(tmin, dt, K, dK/dt, dt_r, ρ, dρ/dt) of the K(s0) Hermite tables (built once, ~ms)."""
-    import scipy.special as sp
-    from scipy.integrate import quad
-
+    gl_x, gl_w = gauss_legendre(12)
     # ---- ratio table on [0, _R_TMAX]
     tr = np.linspace(0.0, _R_TMAX, _R_N)
     dtr = tr[1] - tr[0]
@@ -89,9 +104,9 @@ def k_table():
                  epsrel=1e-13, limit=200)[0]
     kr = np.empty_like(tr)
     kr[-1] = k_top
-    xs = 0.5 * (tr[1:] + tr[:-1])[:, None] + 0.5 * dtr * _GL12_X[None, :]
+    xs = 0.5 * (tr[1:] + tr[:-1])[:, None] + 0.5 * dtr * gl_x[None, :]
     ss = np.exp(xs)
-    panel = 0.5 * dtr * np.sum(_GL12_W[None, :] * (sp.erf(ss) ** 2 * np.exp(-ss * ss)), axis=1)
+    panel = 0.5 * dtr * np.sum(gl_w[None, :] * (sp.erf(ss) ** 2 * np.exp(-ss * ss)), axis=1)
     kr[:-1] = k_top + np.cumsum(panel[::-1])[::-1]
     dk_r = -sp.erf(sr) ** 2 * np.exp(-sr * sr)
     e1r = sp.exp1(sr * sr)
@@ -102,34 +117,22 @@ def k_table():
     dt = t[1] - t[0]
     s = np.exp(t)
     kder = -sp.erf(s) ** 2 * np.exp(-s * s)
-    xs = 0.5 * (t[1:] + t[:-1])[:, None] + 0.5 * dt * _GL12_X[None, :]
+    xs = 0.5 * (t[1:] + t[:-1])[:, None] + 0.5 * dt * gl_x[None, :]
     ss = np.exp(xs)
-    panel = 0.5 * dt * np.sum(_GL12_W[None, :] * (sp.erf(ss) ** 2 * np.exp(-ss * ss)), axis=1)
+    panel = 0.5 * dt * np.sum(gl_w[None, :] * (sp.erf(ss) ** 2 * np.exp(-ss * ss)), axis=1)
     kval = np.empty_like(t)
     kval[-1] = kr[0]
     kval[:-1] = kr[0] + np.cumsum(panel[::-1])[::-1]
     c = np.ascontiguousarray
-    return (float(t[0]), float(dt), c(kval), c(kder), float(dtr), c(rho), c(drho))
+    return KTable(float(t[0]), float(dt), c(kval), c(kder), float(dtr), c(rho), c(drho))
 
 
-#: K(0) (SPEC §2), for tests and documentation
+#: K(0) = ∫_0^∞ erf²(s) e^{-s²} ds/s, for tests and documentation
 K_ZERO = 0.40712493463438924
 
 
-@njit(cache=True)
-def hermite(t, t0, dt, val, der):
-    """Cubic Hermite interpolation on the uniform grid t0 + i dt with values and d/dt."""
-    x = (t - t0) / dt
-    i = int(x)
-    if i < 0:
-        i = 0
-    if i > val.size - 2:
-        i = val.size - 2
-    u = x - i
-    u2 = u * u
-    u3 = u2 * u
-    return ((2 * u3 - 3 * u2 + 1) * val[i] + (u3 - 2 * u2 + u) * dt * der[i]
-            + (-2 * u3 + 3 * u2) * val[i + 1] + (u3 - u2) * dt * der[i + 1])
+#: old name of :func:`fastcontact.kernels.hermite.cubic_uniform`
+hermite = cubic_uniform
 
 
 @njit(cache=True)
@@ -145,10 +148,10 @@ def k_eval(s0, tmin, dt, kval, kder, dtr, rval, rder):
         return (kval[0] + (2.0 / math.pi) * (smin * smin - s0 * s0)
                 - (5.0 / (3.0 * math.pi)) * (smin ** 4 - s0 ** 4))
     if t <= 0.0:
-        return hermite(t, tmin, dt, kval, kder)
+        return cubic_uniform(t, tmin, dt, kval, kder)
     if t >= dtr * (rval.size - 1):
         return 0.5 * e1(s0 * s0)
-    return 0.5 * e1(s0 * s0) * hermite(t, 0.0, dtr, rval, rder)
+    return 0.5 * e1(s0 * s0) * cubic_uniform(t, 0.0, dtr, rval, rder)
 
 
 @njit(cache=True)

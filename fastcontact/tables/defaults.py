@@ -1,4 +1,4 @@
-"""The embedded default surfaces and their precomputed tables (issue #3, item 7).
+"""The embedded default surfaces and their precomputed tables.
 
 The paper's measured spectra are not published as data, so each surface is a documented
 **self-affine stand-in** with the paper's h_rms and parameters typical of its kind, chosen so
@@ -15,13 +15,18 @@ pmma_34um         34 µm    0.8   2π/1 cm         2π/2 mm         1e7      Sec
 
 All tables hold the three flow theories with the paper's defaults (γ = 1, a_perc = 0.5,
 α_cj = 1; the seal experiment rescales σ_cj by α_cj³ = 0.54³). Rebuild all of them with
-``fastcontact tables defaults`` (or :func:`build_default_tables`); the test-suite rebuilds
-them and compares with the shipped files.
+``fastcontact tables defaults`` (or :func:`build_default_tables`) in a source checkout; the
+test-suite rebuilds them and compares with the shipped files.
 """
 from __future__ import annotations
 
 import math
 from pathlib import Path
+
+from .._core.vocab import THEORIES
+from ..surface.psd import SelfAffinePSD
+from .build import precompute
+from .store import Tables
 
 __all__ = ["DEFAULT_SURFACES", "default_surface", "default_table_path", "load_default_tables",
            "build_default_tables"]
@@ -35,9 +40,12 @@ DEFAULT_SURFACES = {
     "pmma_34um": dict(h_rms=34e-6, hurst=0.8, q0=2 * math.pi / 0.01, q_roll=2 * math.pi / 0.002,
                       q1=1e7),
 }
-DEFAULT_THEORIES = ("average", "critical_junction", "emt")
+DEFAULT_THEORIES = THEORIES
 
 PACKAGE_DATA = Path(__file__).resolve().parent.parent / "data"
+#: the repository root when fastcontact runs from a source checkout (None when installed)
+_REPO = Path(__file__).resolve().parent.parent.parent
+SOURCE_CHECKOUT = _REPO if (_REPO / "pyproject.toml").is_file() and (_REPO / "tables").is_dir() else None
 
 
 def _check_name(name):
@@ -49,36 +57,44 @@ def _check_name(name):
 
 def default_surface(name):
     """The SelfAffinePSD stand-in of an embedded default surface."""
-    from ..surface.psd import SelfAffinePSD
-
     return SelfAffinePSD(**DEFAULT_SURFACES[_check_name(name)])
 
 
 def default_table_path(name) -> Path:
-    """Path of the shipped Parquet tables of ``name`` (inside the installed package)."""
+    """Path of the shipped Parquet tables of ``name`` (inside the package; the only definition)."""
     return PACKAGE_DATA / f"{_check_name(name)}.parquet"
 
 
 def load_default_tables(name):
     """The shipped :class:`~fastcontact.tables.Tables` of an embedded default surface."""
-    from . import Tables
-
     return Tables.from_parquet(default_table_path(name))
 
 
 def build_default_tables(outdirs=None, names=None):
     """Rebuild the default tables and write them (atomically) to every folder in ``outdirs``.
 
-    Default folders: the package's ``fastcontact/data`` and, in a source checkout, the
-    repository's top-level ``tables/``. Returns {name: Tables}.
-    """
-    from . import precompute
+    Parameters
+    ----------
+    outdirs : sequence of path-like, optional
+        Folders to write ``<name>.parquet`` into. Default: only in a source checkout, the
+        package's ``fastcontact/data`` and the repository's top-level ``tables/``; an installed
+        package is never written into (pass an explicit folder instead).
+    names : sequence of str, optional
+        Surfaces to rebuild (default all of :data:`DEFAULT_SURFACES`).
 
+    Returns
+    -------
+    dict
+        {name: Tables}.
+    """
     if outdirs is None:
-        outdirs = [PACKAGE_DATA]
-        repo_tables = Path(__file__).resolve().parent.parent.parent / "tables"
-        if repo_tables.is_dir():
-            outdirs.append(repo_tables)
+        if SOURCE_CHECKOUT is None:
+            raise ValueError("outdirs = None is invalid for an installed fastcontact: the package "
+                             "folder is not written into; give an output folder (e.g. "
+                             "`fastcontact tables defaults -o DIR`)")
+        outdirs = [PACKAGE_DATA, SOURCE_CHECKOUT / "tables"]
+    if isinstance(outdirs, (str, Path)):
+        outdirs = [outdirs]
     built = {}
     for name in names or DEFAULT_SURFACES:
         t = precompute(default_surface(name), theories=DEFAULT_THEORIES)

@@ -1,0 +1,231 @@
+"""Numba kernels of the flow-conductivity theories: critical junction, 2-D Bruggeman medium.
+
+Reduced units: ``σ̄ = 12 η σ_eff / h_rms³`` (eq. 23 of Lorenz & Persson 2010), ``p̄ = p/E*``.
+The effective-medium integral runs over the contact-area variable A on [A(ζ1), 1], graded
+towards both ends (t -> A = A1 + (1-A1) t³/(t³+(1-t)³)), with adaptive 7/15 Gauss–Kronrod
+panels: the panel with the largest Kronrod–Gauss difference of the Bruggeman residual is split
+until the estimated relative error of σ̄ is below ``tol``. u1 is evaluated where A(ζ) equals
+each node exactly; nodes where dA/dζ underflows get u1 = ∞ and weight 0 (masked).
+B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 31, 159 (2010), doi:10.1140/epje/i2010-10558-6.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ..contact._kernels import m1_above, u1_at_area
+from ..kernels.quadrature import gauss_kronrod15
+
+__all__ = ["critical_junction_kernel", "emt_kernel", "emt_sigma", "bruggeman", "EMT_TOL",
+           "EMT_MAX_PANELS", "EMT_GRADE"]
+
+
+@njit(cache=True)
+def _area1(cum3, pbar):
+    G1 = 0.25 * math.pi * cum3[-1]
+    return math.erf(pbar / (2.0 * math.sqrt(G1)))
+
+
+@njit(cache=True, parallel=True)
+def critical_junction_kernel(sk, pbar, gamma, a_perc, ktab, glx, glw, panel, u1c, zeta_c,
+                             percolated):
+    """u1(ζc) [m] and ζc per reduced pressure; percolated where A(ζ1)/A0 >= a_perc (eq. 31)."""
+    for i in prange(pbar.size):
+        work = np.empty(4)
+        if _area1(sk.cum3, pbar[i]) >= a_perc:
+            u1c[i] = 0.0
+            zeta_c[i] = math.inf
+            percolated[i] = True
+        else:
+            u, a = u1_at_area(sk, a_perc, pbar[i], gamma, ktab, glx, glw, panel, work)
+            u1c[i] = u
+            zeta_c[i] = a / sk.qb[0]
+            percolated[i] = False
+
+
+_XGK, _WGK, _WG7 = gauss_kronrod15()
+#: target relative accuracy of the effective-medium σ̄ (adaptive quadrature in A)
+EMT_TOL = 1e-8
+EMT_MAX_PANELS = 96
+#: grading exponent of the map t -> A that clusters nodes at both ends of [A(ζ1), 1]
+EMT_GRADE = 3.0
+
+
+@njit(cache=True)
+def _node_terms(s, sj, hzj, almqvist, ghx, ghw):
+    """(Σ 2r, Σ 2r(1-r)) of one node, r = s/(s + σ(u)); Gauss–Hermite average if almqvist."""
+    if sj == math.inf:
+        return 0.0, 0.0  # masked: u1 undefined where dA/dζ = 0; zero weight
+    if not almqvist:
+        if sj == 0.0:
+            return 2.0, 0.0
+        r = s / (s + sj)
+        return 2.0 * r, 2.0 * r * (1.0 - r)
+    mu = sj ** (1.0 / 3.0)
+    acc = 0.0
+    dacc = 0.0
+    for k in range(ghx.size):
+        u = abs(mu + math.sqrt(2.0) * hzj * ghx[k])
+        su = u * u * u
+        r = s / (s + su) if s + su > 0.0 else 1.0
+        acc += ghw[k] * 2.0 * r
+        dacc += ghw[k] * 2.0 * r * (1.0 - r)
+    return acc / math.sqrt(math.pi), dacc / math.sqrt(math.pi)
+
+
+@njit(cache=True)
+def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw):
+    """Solve Σ_j W_j 2s/(s + σ_j) + 2 A1 - 1 = 0 for s > 0 (2-D Bruggeman, reduced units).
+
+    With ``almqvist`` each node is a reflected Gaussian of width hz[j] around u1 = σ_j^(1/3)
+    (Gauss–Hermite nodes ghx, ghw). Returns 0 when A1 >= 0.5 (percolated).
+    """
+    if A1 >= 0.5:
+        return 0.0
+    inv = 0.0
+    smax = 0.0
+    for j in range(W.size):
+        sj = sig[j]
+        if sj == math.inf:
+            continue
+        if almqvist:
+            sj = (sj ** (1.0 / 3.0) + 8.0 * hz[j]) ** 3
+        if sj > 0.0:
+            inv += W[j] / sig[j] if sig[j] > 0.0 else 0.0
+            if sj > smax:
+                smax = sj
+    if smax <= 0.0:
+        return 0.0
+    lo = math.log(max((1.0 - 2.0 * A1) / (2.0 * inv) if inv > 0 else smax * 1e-300, 1e-300)) - 1.0
+    if almqvist:
+        lo -= 30.0
+    hi = math.log(smax) + 1.0
+    y = 0.5 * (lo + hi)
+    for it in range(200):
+        s = max(math.exp(y), 1e-300)
+        f = 2.0 * A1 - 1.0
+        df = 0.0
+        for j in range(W.size):
+            t1, t2 = _node_terms(s, sig[j], hz[j], almqvist, ghx, ghw)
+            f += W[j] * t1
+            df += W[j] * t2
+        if f > 0.0:
+            hi = y
+        else:
+            lo = y
+        yn = y - f / df if df > 0.0 else 0.5 * (lo + hi)
+        if not (lo < yn < hi):
+            yn = 0.5 * (lo + hi)
+        if abs(yn - y) < 1e-15 * max(1.0, abs(y)) or hi - lo < 1e-15:
+            return math.exp(yn)
+        y = yn
+    return math.exp(y)
+
+
+@njit(cache=True)
+def _emt_fill_panel(sk, pbar, A1, t0, t1, h_rms, gamma, ktab, glx, glw, panel, almqvist, work,
+                    sig, hz, WK, WG, off):
+    """u1-based σ(u) at the 15 Kronrod nodes of panel [t0, t1] of the graded variable t."""
+    m = EMT_GRADE
+    half = 0.5 * (t1 - t0)
+    mid = 0.5 * (t1 + t0)
+    for k in range(15):
+        t = mid + half * _XGK[k]
+        tm = t ** m
+        om = (1.0 - t) ** m
+        sfrac = tm / (tm + om)
+        ds = m * (t * (1.0 - t)) ** (m - 1.0) / (tm + om) ** 2
+        area = A1 + (1.0 - A1) * sfrac
+        WK[off + k] = (1.0 - A1) * ds * half * _WGK[k]
+        WG[off + k] = (1.0 - A1) * ds * half * _WG7[k]
+        if area >= 1.0 or area <= A1:
+            sig[off + k] = math.inf
+            hz[off + k] = 0.0
+            continue
+        u, a = u1_at_area(sk, area, pbar, gamma, ktab, glx, glw, panel, work)
+        if not (u < math.inf) or u != u:
+            sig[off + k] = math.inf  # masked: dA/dζ = 0 there
+        else:
+            uh = max(u, 0.0) / h_rms
+            sig[off + k] = uh * uh * uh
+        hz[off + k] = math.sqrt(2.0 * math.pi * m1_above(sk.qb, sk.c, sk.e, a)) / h_rms if almqvist else 0.0
+
+
+@njit(cache=True)
+def emt_sigma(sk, pbar, h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx, ghw, n_start, tol):
+    """Bruggeman σ̄ at one reduced pressure with adaptive Gauss–Kronrod panels in A.
+
+    Returns (σ̄, estimated relative error, number of u1 evaluations).
+    """
+    A1 = _area1(sk.cum3, pbar)
+    if A1 >= 0.5:
+        return 0.0, 0.0, 0
+    cap = EMT_MAX_PANELS * 15
+    sig = np.empty(cap)
+    hz = np.zeros(cap)
+    WK = np.empty(cap)
+    WG = np.empty(cap)
+    pt0 = np.empty(EMT_MAX_PANELS)
+    pt1 = np.empty(EMT_MAX_PANELS)
+    work = np.empty(4)
+    npan = n_start
+    for k in range(npan):
+        pt0[k] = k / npan
+        pt1[k] = (k + 1) / npan
+        _emt_fill_panel(sk, pbar, A1, pt0[k], pt1[k], h_rms, gamma, ktab, glx, glw, panel,
+                        almqvist, work, sig, hz, WK, WG, 15 * k)
+    s = 0.0
+    est = 0.0
+    while True:
+        n = 15 * npan
+        s = bruggeman(WK[:n], sig[:n], A1, almqvist, hz[:n], ghx, ghw)
+        if s <= 0.0:
+            return 0.0, 0.0, n
+        # per-panel error of the Bruggeman residual, relative to d f / d ln s
+        dfl = 0.0
+        worst = -1
+        worst_err = 0.0
+        tot = 0.0
+        for k in range(npan):
+            ek = 0.0
+            eg = 0.0
+            for j in range(15 * k, 15 * k + 15):
+                t1_, t2_ = _node_terms(s, sig[j], hz[j], almqvist, ghx, ghw)
+                ek += WK[j] * t1_
+                eg += WG[j] * t1_
+                dfl += WK[j] * t2_
+            err = abs(ek - eg)
+            tot += err
+            if err > worst_err:
+                worst_err = err
+                worst = k
+        est = tot / dfl if dfl > 0.0 else 0.0
+        if est <= tol or npan >= EMT_MAX_PANELS or worst < 0:
+            return s, est, n
+        # split the worst panel: its left half replaces it, the right half is appended
+        a0 = pt0[worst]
+        a1 = pt1[worst]
+        am = 0.5 * (a0 + a1)
+        pt1[worst] = am
+        _emt_fill_panel(sk, pbar, A1, a0, am, h_rms, gamma, ktab, glx, glw, panel, almqvist,
+                        work, sig, hz, WK, WG, 15 * worst)
+        pt0[npan] = am
+        pt1[npan] = a1
+        _emt_fill_panel(sk, pbar, A1, am, a1, h_rms, gamma, ktab, glx, glw, panel, almqvist,
+                        work, sig, hz, WK, WG, 15 * npan)
+        npan += 1
+
+
+@njit(cache=True, parallel=True)
+def emt_kernel(sk, pbar, h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx, ghw, n_start, tol,
+               sigma, percolated, err, nevals):
+    """Bruggeman σ̄ = 12ησ_eff/h_rms³ per reduced pressure (u1-based P(u))."""
+    for i in prange(pbar.size):
+        percolated[i] = _area1(sk.cum3, pbar[i]) >= 0.5
+        s, es, ne = emt_sigma(sk, pbar[i], h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx,
+                              ghw, n_start, tol)
+        sigma[i] = s
+        err[i] = es
+        nevals[i] = ne

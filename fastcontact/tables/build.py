@@ -1,0 +1,339 @@
+"""The precompute stage: tabulate one surface's contact and flow columns on an adaptive grid.
+
+:func:`precompute` evaluates the direct quadrature of :mod:`fastcontact.contact` and
+:mod:`fastcontact.flow` on a log grid of p̄ = p/E* and refines it until the interpolants of
+:mod:`fastcontact.kernels.lookup` meet :data:`TOLERANCE` at every interval midpoint.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.special import erf
+
+from .._core.validate import check_positive, check_range
+from .._core.vocab import THEORIES
+from ..contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
+from ..flow.conductivity import EMT_TOL, check_theory, sigma_bar
+from ..kernels.hermite import quintic_np
+from ..kernels.locate import Grid
+from ..surface.psd import PSD
+from .store import Tables
+
+__all__ = ["precompute", "default_grid", "TOLERANCE", "DEFAULT_POINTS_PER_DECADE", "SIGMA_FLOOR"]
+
+#: default grid density in p̄ (chosen from bench/bench_tables.py, see bench/RESULTS.md)
+DEFAULT_POINTS_PER_DECADE = 8
+#: the table reaches from ū = U_TOP h_rms ...
+U_TOP = 32.0
+#: ... to A(ζ1)/A0 = AREA_TOP
+AREA_TOP = 0.999
+#: relative interpolation tolerances the adaptive refinement enforces at interval midpoints
+TOLERANCE = {"u": 5e-9, "p_of_u": 5e-9, "slope": 5e-8, "sigma": 2e-7}
+#: σ̄ below this is "at percolation" for the refinement (not resolved further; time scales
+#: there exceed 1e20 τ-units)
+SIGMA_FLOOR = 1e-24
+BOUNDARY_FACTOR = 1e3
+MAX_NODES = 6000
+MIN_DLNP = 1e-6
+
+
+def default_grid(surface: PSD, gamma=1.0, points_per_decade=DEFAULT_POINTS_PER_DECADE) -> Grid:
+    """Base p̄ grid from ū ≈ 32 h_rms (asymptote, eq. 3) to A(ζ1)/A0 = 0.999, snapped to 1/ppd decades.
+
+    Parameters
+    ----------
+    surface : PSD
+        Roughness spectrum.
+    gamma : float
+        Yang–Persson factor in (0, 1] [-].
+    points_per_decade : int
+        Grid density in log10 p̄.
+    """
+    u0, beta = asymptote(surface, gamma)
+    p_lo = beta * math.exp(-U_TOP * surface.h_rms / u0)
+    p_hi = float(percolation_pressure(surface, 1.0, AREA_TOP))
+    ppd = int(points_per_decade)
+    lo = math.floor(math.log10(p_lo) * ppd) / ppd
+    hi = math.ceil(math.log10(p_hi) * ppd) / ppd
+    return Grid(lo, hi, int(round((hi - lo) * ppd)) + 1)
+
+
+def _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist):
+    """(theories in request order without repeats, validated options dict)."""
+    if isinstance(theories, str):
+        theories = (theories,)
+    theories = tuple(dict.fromkeys(check_theory(t) for t in theories))
+    if not theories:
+        raise ValueError("theories = () is invalid: request at least one of "
+                         f"{list(THEORIES)}")
+    return theories, {
+        "gamma": _check_gamma(gamma),
+        "a_perc": float(check_range("a_perc", a_perc, 0.0, 1.0, "[-]", lo_open=True, hi_open=True)),
+        "alpha_cj": float(check_positive("alpha_cj", alpha_cj, "[-]")),
+        "emt_tol": float(check_range("emt_tol", emt_tol, 1e-13, 1e-2, "[-]")),
+        "emt_almqvist": bool(emt_almqvist),
+    }
+
+
+def _check_grid(grid):
+    """A user grid ``(log10_min, log10_max, n)`` as a :class:`Grid`, or ValueError."""
+    try:
+        g = Grid(float(grid[0]), float(grid[1]), int(grid[2]))
+        ok = (len(grid) == 3 and math.isfinite(g.log10_min) and math.isfinite(g.log10_max)
+              and g.n == grid[2] and g.n >= 5 and g.log10_max > g.log10_min)
+    except (TypeError, ValueError, IndexError, OverflowError):
+        ok = False
+    if not ok:
+        raise ValueError(f"grid = {grid!r} is invalid: must be (log10_min, log10_max, n) with "
+                         f"finite log10_max > log10_min and integer n >= 5")
+    return g
+
+
+def _cj_derivatives(psd, pbar, sb, sig_opts):
+    """(d ln σ̄/d ln p̄, d² ln σ̄/d(ln p̄)²) of the critical junction by central differences."""
+    eps = 1e-4
+    up = sigma_bar(psd, pbar * math.exp(eps), "critical_junction", **sig_opts).sigma_bar
+    um = sigma_bar(psd, pbar * math.exp(-eps), "critical_junction", **sig_opts).sigma_bar
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = (np.log(up) - np.log(um)) / (2 * eps)
+        d2 = (np.log(up) - 2 * np.log(sb) + np.log(um)) / eps ** 2
+    return np.where(np.isfinite(d) & (sb > 0), d, 0.0), np.where(np.isfinite(d2) & (sb > 0), d2, 0.0)
+
+
+def _exact(psd, pbar, theories, sig_opts):
+    """Exact columns at reduced pressures pbar (direct quadrature)."""
+    pbar = np.ascontiguousarray(pbar, dtype=np.float64)
+    u, du, d2u = _separation(psd, pbar, 1.0, 1.0, sig_opts["gamma"], second=True)
+    h = psd.h_rms
+    out = {"u": u / h, "dlnu": du / u, "d2lnu": d2u / u - (du / u) ** 2}
+    for th in theories:
+        sb, perc, extra = sigma_bar(psd, pbar, th, **sig_opts)
+        out[f"sigma_{th}"] = sb
+        out[f"percolated_{th}"] = perc
+        if th == "average":
+            out[f"dlnsigma_{th}"] = 3.0 * out["dlnu"]
+            out[f"d2lnsigma_{th}"] = 3.0 * out["d2lnu"]
+        elif th == "critical_junction":
+            out[f"dlnsigma_{th}"], out[f"d2lnsigma_{th}"] = _cj_derivatives(psd, pbar, sb, sig_opts)
+            out["zeta_c"] = extra.zeta_c
+            out["u1c_over_h"] = extra.u1c
+    return out
+
+
+def _node_derivative(x, y, ok):
+    """(dy/dx, d²y/dx²) at the open nodes from the degree-4 polynomial through the 5 nearest."""
+    d = np.zeros_like(y)
+    d2 = np.zeros_like(y)
+    idx = np.flatnonzero(ok)
+    m = idx.size
+    if m < 3:
+        return d, d2
+    w = min(5, m)
+    k = np.arange(m)
+    lo = np.clip(k - w // 2, 0, m - w)
+    sten = idx[lo[:, None] + np.arange(w)[None, :]]            # (m, w) node indices
+    dx = x[sten] - x[idx][:, None]                             # local abscissae
+    V = dx[:, :, None] ** np.arange(w)[None, None, :]          # Vandermonde (m, w, w)
+    coef = np.linalg.solve(V, y[sten][:, :, None])[:, :, 0]
+    d[idx] = coef[:, 1]
+    d2[idx] = 2.0 * coef[:, 2]
+    return d, d2
+
+
+def _interval_errors(lnp, cols, mids, theories):
+    """Relative midpoint errors of each column's interpolant, per interval (inf: overflow)."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        return _interval_errors_raw(lnp, cols, mids, theories)
+
+
+def _interval_errors_raw(lnp, cols, mids, theories):
+    x0, x1 = lnp[:-1], lnp[1:]
+    xm = 0.5 * (x0 + x1)
+    lnu = np.log(cols["u"])
+    du = cols["dlnu"]
+    d2 = cols["d2lnu"]
+    args = (x0, x1, lnu[:-1], lnu[1:], du[:-1], du[1:], d2[:-1], d2[1:])
+    est = quintic_np(xm, *args)
+    err = {"u": np.abs(np.expm1(est - np.log(mids["u"])))}
+    slope = quintic_np(xm, *args, deriv=True)
+    err["slope"] = np.abs(slope / mids["dlnu"] - 1.0)
+    lnum = np.log(mids["u"])
+    est_p = quintic_np(lnum, lnu[:-1], lnu[1:], x0, x1, 1 / du[:-1], 1 / du[1:],
+                       -d2[:-1] / du[:-1] ** 3, -d2[1:] / du[1:] ** 3)
+    err["p_of_u"] = np.abs(np.expm1(est_p - xm))
+    for th in theories:
+        s = cols[f"sigma_{th}"]
+        sm = mids[f"sigma_{th}"]
+        ok = (s[:-1] > SIGMA_FLOOR) & (s[1:] > SIGMA_FLOOR) & (sm > SIGMA_FLOOR)
+        e = np.zeros(xm.size)
+        if np.any(ok):
+            ds = cols[f"dlnsigma_{th}"]
+            d2s = cols[f"d2lnsigma_{th}"]
+            est_s = quintic_np(xm[ok], x0[ok], x1[ok], np.log(s[:-1][ok]), np.log(s[1:][ok]),
+                               ds[:-1][ok], ds[1:][ok], d2s[:-1][ok], d2s[1:][ok])
+            e[ok] = np.abs(np.expm1(est_s - np.log(sm[ok])))
+        err[f"sigma_{th}"] = e
+    return err
+
+
+def _emt_node_derivatives(lnp, cols):
+    """EMT d ln σ̄/d ln p̄ and its derivative from local quartics through the open nodes."""
+    s = cols["sigma_emt"]
+    ok = s > SIGMA_FLOOR
+    with np.errstate(divide="ignore"):
+        cols["dlnsigma_emt"], cols["d2lnsigma_emt"] = _node_derivative(
+            lnp, np.where(ok, np.log(np.where(ok, s, 1)), 0), ok)
+
+
+def _flag_intervals(lnp, cols, mids, theories, tol):
+    """(intervals to split, midpoint errors): interpolation misses and floor-straddlers."""
+    errs = _interval_errors(lnp, cols, mids, theories)
+    bad = np.zeros(lnp.size - 1, dtype=bool)
+    for c, e in errs.items():
+        bad |= e > tol["sigma" if c.startswith("sigma") else c]
+    # intervals straddling the σ̄ floor (the super-exponential collapse of u1(ζc) before
+    # percolation) are bisected until their open end is within BOUNDARY_FACTOR of it
+    for th in theories:
+        sg = cols[f"sigma_{th}"]
+        above = sg > SIGMA_FLOOR
+        straddle = above[:-1] != above[1:]
+        open_end = np.maximum(sg[:-1], sg[1:])
+        bad |= straddle & (open_end > BOUNDARY_FACTOR * SIGMA_FLOOR)
+    bad &= (lnp[1:] - lnp[:-1]) > 2 * MIN_DLNP
+    return bad, errs
+
+
+def _refine(psd, grid, theories, sig_opts, tol, refine):
+    """Adaptive bisection of the base grid; returns (ln p̄ nodes, columns, errors, stats)."""
+    lnp = grid.ln_nodes()
+    cols = _exact(psd, np.exp(lnp), theories, sig_opts)
+    mid_cache = {}
+    rounds = 0
+    while True:
+        rounds += 1
+        if "emt" in theories:
+            _emt_node_derivatives(lnp, cols)
+        xm = 0.5 * (lnp[:-1] + lnp[1:])
+        need = np.array([x not in mid_cache for x in xm])
+        if np.any(need):
+            new = _exact(psd, np.exp(xm[need]), theories, sig_opts)
+            for k, x in enumerate(xm[need]):
+                mid_cache[x] = {c: v[k] for c, v in new.items()}
+        mids = {c: np.array([mid_cache[x][c] for x in xm]) for c in cols
+                if c not in ("dlnsigma_emt", "d2lnsigma_emt")}
+        if not np.all(np.diff(np.log(np.concatenate(([cols["u"][0]], mids["u"])))) < 0) \
+                or not np.all(np.diff(cols["u"]) < 0):
+            raise ValueError(f"grid = {tuple(grid)!r} is invalid for this surface: ū(p) is not "
+                             f"resolved as strictly decreasing")
+        bad, errs = _flag_intervals(lnp, cols, mids, theories, tol)
+        if not refine or not np.any(bad) or lnp.size + bad.sum() > MAX_NODES:
+            break
+        # split: the midpoints become nodes (their exact values are already known)
+        add = xm[bad]
+        order = np.argsort(np.concatenate((lnp, add)), kind="stable")
+        lnp = np.concatenate((lnp, add))[order]
+        for c in cols:
+            extra = mids[c][bad] if c in mids else np.zeros(int(bad.sum()))
+            cols[c] = np.concatenate((cols[c], extra))[order]
+    return lnp, cols, errs, {"refinement_rounds": rounds, "exact_evaluations": int(grid.n + len(mid_cache))}
+
+
+def _assemble(psd, lnp, cols, theories, options):
+    """The table columns and percolation pressures from the refined nodes."""
+    pbar = np.exp(lnp)
+    data = {"p_over_E": pbar, "u_over_h": cols["u"], "dlnu_dlnp": cols["dlnu"],
+            "d2lnu_dlnp2": cols["d2lnu"]}
+    G1 = 0.25 * math.pi * psd.cum3[-1]
+    data["area_fraction"] = erf(pbar / (2.0 * math.sqrt(G1)))
+    perc_p = {}
+    for th in theories:
+        open_ = cols[f"sigma_{th}"] > 0
+        data[f"sigma_{th}"] = cols[f"sigma_{th}"]
+        data[f"dlnsigma_{th}"] = np.where(open_, cols[f"dlnsigma_{th}"], 0.0)
+        data[f"d2lnsigma_{th}"] = np.where(open_, cols[f"d2lnsigma_{th}"], 0.0)
+        data[f"phi_{th}"] = cols[f"sigma_{th}"] / cols["u"] ** 3
+        data[f"percolated_{th}"] = cols[f"percolated_{th}"].astype(bool)
+        if th == "critical_junction":
+            data["zeta_c"] = cols["zeta_c"]
+            data["u1c_over_h"] = cols["u1c_over_h"]
+        a_perc = options["a_perc"] if th == "critical_junction" else 0.5
+        perc_p[th] = math.inf if th == "average" else float(percolation_pressure(psd, 1.0, a_perc))
+    zg = Grid(0.0, math.log10(psd.zeta1), pbar.size)
+    zeta = zg.nodes()
+    zeta[-1] = psd.zeta1
+    data["zeta"] = zeta
+    data["G_over_Estar2"] = 0.25 * math.pi * np.asarray(psd.moment(3.0, psd.q0, zeta * psd.q0))
+    return {k: np.ascontiguousarray(v) for k, v in data.items()}, perc_p, zg
+
+
+def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid=None, *,
+               emt_tol=EMT_TOL, emt_almqvist=False, points_per_decade=None, tolerance=None,
+               refine=True):
+    """Tabulate ū (A4), A (A1), u1(ζc) (A3), σ̄ (eq. 23) and φ_p of a surface on a grid of p̄ = p/E*.
+
+    The base grid (uniform in ln p̄) is refined adaptively: every interval whose Hermite
+    interpolant misses the exact quadrature at its midpoint by more than ``tolerance``
+    (relative; ū, p_cont(ū), the slope d ln ū/d ln p̄ that sets squeeze-out rates near
+    equilibrium, and each σ̄ above SIGMA_FLOOR) is split, until all pass.
+    The midpoint errors of the final grid are recorded in ``info["interpolation_error"]``.
+
+    Parameters
+    ----------
+    psd : PSD
+        The roughness spectrum (Persson convention).
+    theories : sequence of str
+        Any of "average", "critical_junction", "emt"; only these are computed (default all).
+    gamma : float
+        Yang–Persson factor in (0, 1] [-] (1 = the paper's A4).
+    a_perc : float
+        Critical-junction percolation threshold A(ζc)/A0 in (0, 1) [-] (0.5; 0.42 option).
+    alpha_cj : float
+        Critical-junction factor on u1(ζc) [-], > 0.
+    grid : Grid or (log10_min, log10_max, n), optional
+        Base p̄ grid (default: :func:`default_grid`).
+    emt_tol : float
+        Relative accuracy of the adaptive effective-medium integral [-].
+    emt_almqvist : bool
+        Almqvist-broadened separation distribution in the effective medium.
+    points_per_decade : int, optional
+        Density of the default base grid.
+    tolerance : dict, optional
+        Overrides of :data:`TOLERANCE` ("u", "p_of_u", "slope", "sigma").
+    refine : bool
+        False: keep the base grid (errors are still measured and recorded).
+
+    Returns
+    -------
+    Tables
+        The tables; ``info`` records the asymptote (eq. 3), percolation pressures, the
+        midpoint errors, node count and build time [s].
+
+    References
+    ----------
+    B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10626-9.
+    """
+    t_start = time.perf_counter()
+    _check_psd(psd)
+    theories, options = _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist)
+    gamma = options["gamma"]
+    if grid is None:
+        ppd = DEFAULT_POINTS_PER_DECADE if points_per_decade is None else points_per_decade
+        ppd = int(check_range("points_per_decade", ppd, 1, 1000, "[1/decade]"))
+        grid = default_grid(psd, gamma, ppd)
+    else:
+        grid = _check_grid(grid)
+    tol = dict(TOLERANCE)
+    tol.update(tolerance or {})
+    sig_opts = dict(gamma=gamma, a_perc=options["a_perc"], alpha_cj=options["alpha_cj"],
+                    tol=options["emt_tol"], almqvist=options["emt_almqvist"])
+    lnp, cols, errs, stats = _refine(psd, grid, theories, sig_opts, tol, refine)
+    data, perc_p, zg = _assemble(psd, lnp, cols, theories, options)
+    u0, beta = asymptote(psd, gamma)
+    info = {"asymptote_u0_over_h": u0 / psd.h_rms, "asymptote_beta": beta,
+            "percolation_p_over_E": perc_p,
+            "interpolation_error": {c: float(e.max()) for c, e in errs.items()},
+            "tolerance": tol, "sigma_floor": SIGMA_FLOOR, "nodes": int(lnp.size), **stats,
+            "build_seconds": time.perf_counter() - t_start}
+    return Tables(psd, theories, options, grid, zg, data, info)
