@@ -94,7 +94,7 @@ def test_parseval_2d(case, sa_psd, gauss_map, exact_map):
         h = synthetic_heights(SelfAffinePSD(1e-6, 0.8, Q_LO, Q_NY, 8 * Q_LO), N, A, seed=5)
     with warnings.catch_warnings():
         warnings.simplefilter("error")            # no Parseval warning either
-        psd = psd_from_heights(h, A)
+        psd = psd_from_heights(h, A, periodic=True)
     assert isinstance(psd, TabulatedPSD) and psd.convention == "persson"
     # the band starts at the equal-area radius of the origin's lattice cell (the cells of the
     # lowest shell at 2π/L reach down to it), √(Δqx Δqy / π) ≈ 0.56·2π/L for a square map
@@ -108,7 +108,7 @@ def test_parseval_2d_detrend_plane(gauss_map):
     """A tilt added to the map is removed by detrend='plane' (the mean alone would not)."""
     y, x = np.mgrid[0:N, 0:N] * A
     tilted = gauss_map + 0.02 * x - 0.01 * y + 3e-6
-    psd = psd_from_heights(tilted, A, detrend="plane")
+    psd = psd_from_heights(tilted, A, detrend="plane", periodic=True)
     assert psd.h_rms == pytest.approx(rms(gauss_map), rel=0.01)
 
 
@@ -120,7 +120,7 @@ def test_parseval_holds_without_a_resolved_roll_off(hurst, seed):
     h = synthetic_heights(psd, 256, A * 2, seed=seed)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        out = psd_from_heights(h, A * 2)
+        out = psd_from_heights(h, A * 2, periodic=True)
     assert out.h_rms == pytest.approx(rms(h - h.mean()), rel=0.01)
 
 
@@ -129,7 +129,7 @@ def test_parseval_warning_when_roughness_lies_beyond_nyquist():
     isotropic spectrum up to the Nyquist wavevector cannot hold -> RuntimeWarning."""
     h = np.random.default_rng(0).standard_normal((256, 256)) * 1e-6
     with pytest.warns(RuntimeWarning, match="h_rms"):
-        psd_from_heights(h, A)
+        psd_from_heights(h, A, periodic=True)
 
 
 def test_hann_window_keeps_variance_on_average(gauss_map):
@@ -144,7 +144,7 @@ def test_hann_window_keeps_variance_on_average(gauss_map):
 def test_exact_map_recovers_input_psd(sa_psd, exact_map):
     """No statistical scatter: the area-preserving table reproduces C(q) — power law and
     roll-off kink included — to 1.5 % from q_lo up to the last bin below q_Ny."""
-    psd = psd_from_heights(exact_map, A)
+    psd = psd_from_heights(exact_map, A, periodic=True)
     q, c = psd.q_samples[:-1], psd.C_samples[:-1]
     inside = q >= Q_LO * (1 - 1e-12)          # the input spectrum starts at 2π/L
     np.testing.assert_allclose(c[inside] / sa_psd(q[inside]), 1.0, atol=0.015)
@@ -158,7 +158,7 @@ def test_gaussian_map_follows_input_psd(sa_psd, gauss_map):
     ≤ 1/√950 = 3.3 %, ×~1.3 after the area-preserving deconvolution, so 20 % is > 4σ
     (measured max deviation 2.6–9.9 % on 20 seeds); the band average is within 4 % (measured
     ≤ 2.2 % on 16 seeds)."""
-    psd = psd_from_heights(gauss_map, A)
+    psd = psd_from_heights(gauss_map, A, periodic=True)
     q, c = psd.q_samples, psd.C_samples
     band = (q >= 2 * Q_R) & (q <= Q_NY / 2)
     assert band.sum() >= 5
@@ -175,17 +175,17 @@ def test_band_limited_map_is_trimmed_not_garbage():
     q_lo = 2 * math.pi / (n * A)
     psd = SelfAffinePSD(1e-6, 0.8, 4 * q_lo, Q_NY / 4, 16 * q_lo)
     h = synthetic_heights(psd, n, A, seed=0)
-    fit = psd_from_heights(h, A)
+    fit = psd_from_heights(h, A, periodic=True)
     assert 0.85 * psd.q0 < fit.q0 <= psd.q0 and psd.q1 <= fit.q1 < 1.3 * psd.q1
     assert fit.h_rms == pytest.approx(rms(h), rel=0.01)
-    lines = psd_from_heights(h, A, line_scans=True)
+    lines = psd_from_heights(h, A, line_scans=True, periodic=True)
     assert lines.q1 < 1.3 * psd.q1
     assert lines.h_rms == pytest.approx(rms(h), rel=0.05)
 
 
 def test_n_bins_changes_resolution_not_parseval(gauss_map):
-    coarse = psd_from_heights(gauss_map, A, n_bins=8)
-    fine = psd_from_heights(gauss_map, A, n_bins=60)
+    coarse = psd_from_heights(gauss_map, A, n_bins=8, periodic=True)
+    fine = psd_from_heights(gauss_map, A, n_bins=60, periodic=True)
     assert coarse.q_samples.size < fine.q_samples.size
     for psd in (coarse, fine):
         assert psd.h_rms == pytest.approx(rms(gauss_map), rel=0.01)
@@ -238,7 +238,7 @@ def test_line_scans_exact_map(sa_psd, exact_map):
     the 2-D C(q) to 2 % in the self-affine band 2·q_r … q_Ny/3 (measured 0.2 %), along either
     axis."""
     for axis in (0, 1):
-        psd = psd_from_heights(line_scans(exact_map, axis=axis), A, line_scans=True)
+        psd = psd_from_heights(line_scans(exact_map, axis=axis), A, line_scans=True, periodic=True)
         q = psd.q_samples
         band = (q >= 2 * Q_R) & (q <= Q_NY / 3)
         np.testing.assert_allclose(psd.C_samples[band] / sa_psd(q[band]), 1.0, atol=0.02)
@@ -250,7 +250,7 @@ def test_line_scans_gaussian_map(sa_psd, gauss_map):
     perpendicular to the scans that every profile misses (its mean is removed), so psd.h_rms
     exceeds the profiles' rms — by +1.9 … +5.5 % measured on 16 seeds — and matches the
     map's rms to 6 % (measured ≤ 4.3 %)."""
-    psd = psd_from_heights(gauss_map, A, line_scans=True)
+    psd = psd_from_heights(gauss_map, A, line_scans=True, periodic=True)
     q = psd.q_samples
     band = (q >= 2 * Q_R) & (q <= Q_NY / 3)
     ratio = psd.C_samples[band] / sa_psd(q[band])
@@ -263,7 +263,7 @@ def test_line_scans_gaussian_map(sa_psd, gauss_map):
 def test_single_line_scan(sa_psd, gauss_map):
     """One 1-D profile: a valid spectrum on [2π/L, π/a]; the self-affine band within a factor
     1.75 (one scan of 512 points: rms scatter ~15 %, worst node a factor 1.5 on 16 seeds)."""
-    psd = psd_from_heights(gauss_map[7], A)
+    psd = psd_from_heights(gauss_map[7], A, periodic=True)
     assert psd.q0 == pytest.approx(Q_LO) and psd.q1 == pytest.approx(Q_NY)
     q = psd.q_samples
     band = (q >= 2 * Q_R) & (q <= Q_NY / 3)
@@ -275,7 +275,7 @@ def test_line_psd_parseval(gauss_map):
     """1-D spectrum normalisation h_rms² = 2∫C1D dq: the table on [2π/L, π/a] holds the
     profiles' variance except half of the lowest lattice cell (2-3 % here; 2.5 ± 0.75 % on
     16 seeds)."""
-    q, d = line_psd(gauss_map, A)
+    q, d = line_psd(gauss_map, A, periodic=True)
     energy = 2 * TabulatedPSD(q, d).moment(0.0)
     profiles = gauss_map - gauss_map.mean(axis=1, keepdims=True)
     assert energy / np.mean(profiles ** 2) == pytest.approx(0.975, abs=0.015)
@@ -294,7 +294,7 @@ def test_line_scans_helper():
 # ============================================================================ files
 @pytest.fixture(scope="module")
 def measured_psd(gauss_map):
-    return psd_from_heights(gauss_map, A)
+    return psd_from_heights(gauss_map, A, periodic=True)
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".csv.gz", ".parquet"])

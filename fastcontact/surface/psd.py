@@ -1,4 +1,4 @@
-"""Surface roughness power spectra C(q) in the Persson convention (SPEC §1).
+"""Surface roughness power spectra C(q) in the Persson convention.
 
 Glossary
 --------
@@ -30,11 +30,10 @@ import math
 import numpy as np
 
 from .._core.validate import as_float_array, check_positive, check_range
+from .._core.vocab import CONVENTIONS
 
 __all__ = ["PSD", "SelfAffinePSD", "TabulatedPSD", "CONVENTIONS", "psd_from_dict"]
 
-#: accepted names of the C(q) normalisation, and the factor that turns each into Persson's
-CONVENTIONS = {"persson": 1.0, "surface_topography": 1.0 / (2.0 * math.pi) ** 2}
 
 
 def _segment_moment(c, qs, e, n, a, b):
@@ -135,7 +134,7 @@ class PSD:
         return self.qb, self.c, self.e, self.cum3
 
     def restricted(self, q_min: float) -> "TabulatedPSD":
-        """The spectrum restricted to q >= q_min (asperity-scale problems, SPEC §4)."""
+        """The spectrum restricted to q >= q_min [1/m] (asperity-scale problems)."""
         check_range("q_min", q_min, self.q0, self.q1, "[1/m]", hi_open=True)
         j = int(np.searchsorted(self.qb, q_min, side="right"))
         qb = np.concatenate(([q_min], self.qb[j:]))
@@ -174,7 +173,7 @@ class PiecewisePowerLawPSD(PSD):
 
 
 class SelfAffinePSD(PSD):
-    """Self-affine spectrum with optional roll-off (SPEC §1).
+    """Self-affine spectrum with optional roll-off.
 
     ``C = C0 q_roll^(-2(1+H))`` on [q0, q_roll), ``C = C0 q^(-2(1+H))`` on [q_roll, q1], 0 elsewhere,
     with C0 fixed by the requested ``h_rms``.
@@ -237,8 +236,13 @@ class TabulatedPSD(PSD):
         if convention not in CONVENTIONS:
             raise ValueError(f"convention = {convention!r} is invalid: must be one of "
                              f"{sorted(CONVENTIONS)} (Persson's C, or SurfaceTopography's (2π)² C)")
-        q = as_float_array("q", q).ravel()
-        C = as_float_array("C", C).ravel()
+        q = as_float_array("q", q, "[1/m]")
+        C = as_float_array("C", C, "[m^4]")
+        for nm, arr in (("q", q), ("C", C)):
+            if arr.ndim != 1:
+                raise ValueError(f"{nm} has shape {arr.shape} (ndim = {arr.ndim}) is invalid: "
+                                 f"must be a 1-D array of samples (a 2-D input is never "
+                                 f"flattened)")
         if q.size < 2:
             raise ValueError(f"q has {q.size} samples: must have at least 2")
         if C.shape != q.shape:

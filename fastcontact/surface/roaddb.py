@@ -17,16 +17,21 @@ deterministic by seed.
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 from pathlib import Path
 
 import numpy as np
 
+from .._core.io import atomic_path
+from .._core.vocab import CONVENTIONS
+from .io import CONVENTION_KEY, read_psd
+from .psd import TabulatedPSD
+
 __all__ = ["generate_road_database", "open_road_database", "RoadDatabase", "CONVENTION_KEY",
            "synthetic_road_psd"]
 
-CONVENTION_KEY = b"fastcontact.convention"
 DB_KEY = b"fastcontact.roaddb"
 #: surfaces per Parquet part file written by generate_road_database
 SURFACES_PER_PART = 250
@@ -38,7 +43,6 @@ MIN_SLOPE, MAX_SLOPE = 0.3, 4.0
 
 def _atomic_write_table(table, path: Path):
     import pyarrow.parquet as pq
-    from .._core.io import atomic_path
     with atomic_path(path) as tmp:
         pq.write_table(table, tmp)
     return path
@@ -58,7 +62,6 @@ def synthetic_road_psd(rng, n_q=N_Q):
     lowered (not below 1e5 1/m) until ξ = 4, and draws that cannot be fixed that way or have
     ξ < MIN_SLOPE = 0.3 are redrawn.
     """
-    from .psd import TabulatedPSD
 
     def spectrum(q0, q1, n_q, q_roll, hurst, h_rms, smooth_noise):
         q = np.geomspace(q0, q1, n_q)
@@ -111,7 +114,6 @@ def generate_road_database(path, n_surfaces, seed, *, n_q=N_Q, surfaces_per_part
     See :func:`synthetic_road_psd` for the distribution of the spectra.
     """
     import pyarrow as pa
-    from .psd import CONVENTIONS
     if isinstance(n_surfaces, bool) or not isinstance(n_surfaces, (int, np.integer)) or n_surfaces < 1:
         raise ValueError(f"n_surfaces = {n_surfaces!r} is invalid: must be an integer >= 1")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -193,7 +195,6 @@ class RoadDatabase:
 
     def _read_long(self, f, convention):
         import pyarrow.parquet as pq
-        from .psd import CONVENTIONS
         try:
             table = pq.read_table(f)
         except Exception as exc:  # noqa: BLE001
@@ -240,7 +241,6 @@ class RoadDatabase:
         if sid in self._spectra:
             return self._spectra[sid]
         if sid in self._files:
-            from .topography import read_psd
             f = self._files[sid]
             conv = self.convention
             if conv is None and f.name.lower().endswith((".parquet", ".pq")):
@@ -256,13 +256,11 @@ class RoadDatabase:
         raise KeyError(f"surface_id {sid!r} is not in the database")
 
     def psd(self, sid):
-        from .psd import TabulatedPSD
         q, C = self.spectrum(sid)
         return TabulatedPSD(q, C, convention="persson")
 
     @property
     def fingerprint(self):
-        import hashlib
         h = hashlib.sha256()
         for sid in self.ids:
             q, C = self.spectrum(sid)
