@@ -19,6 +19,8 @@ message on stderr, no traceback.
 from __future__ import annotations
 
 import argparse
+import importlib
+import importlib.util
 import json
 import math
 import sys
@@ -34,19 +36,36 @@ class CLIError(ValueError):
 
 
 class _Parser(argparse.ArgumentParser):
+    """One-line errors (exit 2) and every option's default shown in its help."""
+
+    def __init__(self, *args, **kw):
+        kw.setdefault("formatter_class", argparse.ArgumentDefaultsHelpFormatter)
+        super().__init__(*args, **kw)
+
     def error(self, message):  # one line, exit 2
         raise CLIError(f"{self.prog}: {message}")
 
 
 def _quantity(dim):
     def conv(text):
-        from .studies.scene import parse_quantity
+        from ._core.units import parse_quantity
         try:
             return parse_quantity("value", text, dim)
         except ValueError as exc:
             raise argparse.ArgumentTypeError(str(exc).replace("value = ", "")) from None
     conv.__name__ = dim
     return conv
+
+
+def _count(text):
+    """A positive whole number, also written as 2e7."""
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (x >= 1 and x == int(x)):
+        raise argparse.ArgumentTypeError(f"{text!r} must be a whole number >= 1")
+    return int(x)
 
 
 def build_parser():
@@ -59,16 +78,23 @@ def build_parser():
     r = sub.add_parser("run", help="run a scene (TOML) and write results, summary and figures")
     r.add_argument("scene", nargs="?", help="scene file or shipped example name")
     r.add_argument("--default", action="store_true", help="run the default scene (embedded tables)")
-    r.add_argument("-o", "--outdir", required=True, help="output folder")
-    r.add_argument("--cache-dir", help="table cache (default $FASTCONTACT_CACHE_DIR or "
-                   "~/.cache/fastcontact/tables)")
-    r.add_argument("-q", "--quiet", action="store_true")
+    r.add_argument("-o", "--outdir", required=True,
+                   help="output folder (created; files in an existing folder are replaced)")
+    r.add_argument("--cache-dir", help="table cache folder (default: $FASTCONTACT_CACHE_DIR, "
+                   "else the user cache folder from platformdirs, + /tables)")
+    r.add_argument("--max-cases", type=_count, default=None,
+                   help="largest study allowed, cases x surfaces (default: the scene's "
+                        "[outputs] max_cases, else 2e7)")
+    r.add_argument("--no-figures", action="store_true", help="do not draw the scene's figures")
+    r.add_argument("-q", "--quiet", action="store_true", help="no progress messages or bar")
 
     v = sub.add_parser("validate", help="validate a scene; report every problem; write nothing")
-    v.add_argument("scene")
+    v.add_argument("scene", help="scene file or shipped example name")
+    v.add_argument("--max-cases", type=_count, default=None,
+                   help="largest study allowed (default: the scene's, else 2e7)")
 
     s = sub.add_parser("scenes", help="list the shipped example scenes, or print one")
-    s.add_argument("name", nargs="?")
+    s.add_argument("name", nargs="?", help="example scene to print")
 
     t = sub.add_parser("tables", help="build or inspect contact/flow tables")
     tsub = t.add_subparsers(dest="tables_command", metavar="SUBCOMMAND", parser_class=_Parser)
@@ -88,79 +114,98 @@ def build_parser():
     tb.add_argument("--alpha-cj", type=float, default=1.0, help="critical-junction factor")
     tb.add_argument("-o", "--output", required=True, help="output .parquet file")
     ti = tsub.add_parser("info", help="show a table file's metadata")
-    ti.add_argument("file")
+    ti.add_argument("file", help="tables .parquet file")
     ti.add_argument("--json", action="store_true", help="print the raw metadata as JSON")
-    td = tsub.add_parser("defaults", help="rebuild the embedded default tables (tables/, package data)")
+    td = tsub.add_parser("defaults", help="rebuild the embedded default tables")
     td.add_argument("-o", "--output-dir", action="append",
-                    help="folder to write to (repeatable; default: the package data and the "
-                         "checkout's tables/ folder)")
+                    help="folder to write to (repeatable; default: ./tables of a source "
+                         "checkout; never the installed package)")
 
     w = sub.add_parser("sweep", help="evaluate a scene on every surface of a road database (Dask)")
     w.add_argument("database", help="road database (Parquet dataset or folder of PSD files)")
-    w.add_argument("-o", "--outdir", required=True)
+    w.add_argument("-o", "--outdir", required=True, help="output folder (data/ + manifest.json)")
     w.add_argument("--scene", required=True, help="scene file or shipped example name")
     w.add_argument("--scheduler", help="address of an existing Dask scheduler")
     w.add_argument("--workers", type=int, help="local worker processes (default: cores)")
     w.add_argument("--convention", choices=("persson", "surface_topography"),
                    help="C convention of database files that record none")
     w.add_argument("--cache-dir", help="keep/reuse the tables there (default: not kept)")
-    w.add_argument("--no-progress", action="store_true")
+    w.add_argument("--no-progress", action="store_true", help="no progress line")
 
     f = sub.add_parser("figures", help="regenerate every paper figure the engine makes")
-    f.add_argument("-o", "--outdir", required=True)
+    f.add_argument("-o", "--outdir", required=True, help="output folder for the PNG files")
 
     d = sub.add_parser("roaddb", help="road databases")
     dsub = d.add_subparsers(dest="roaddb_command", metavar="SUBCOMMAND", parser_class=_Parser)
     dg = dsub.add_parser("generate", help="write a synthetic road database")
-    dg.add_argument("path")
+    dg.add_argument("path", help="output Parquet dataset folder")
     dg.add_argument("-n", "--n", dest="n", type=int, required=True, help="number of surfaces")
-    dg.add_argument("--seed", type=int, required=True)
-    dg.add_argument("--n-q", type=int, default=None, help="samples per spectrum")
-    dg.add_argument("--convention", choices=("persson", "surface_topography"), default="persson")
+    dg.add_argument("--seed", type=int, required=True, help="random seed")
+    dg.add_argument("--n-q", type=int, default=None,
+                    help="samples per spectrum (default: the roaddb module's N_Q)")
+    dg.add_argument("--convention", choices=("persson", "surface_topography"), default="persson",
+                    help="C convention written to the files")
     di = dsub.add_parser("info", help="summarise a road database")
-    di.add_argument("path")
-    di.add_argument("--convention", choices=("persson", "surface_topography"))
+    di.add_argument("path", help="road database (Parquet dataset or folder of PSD files)")
+    di.add_argument("--convention", choices=("persson", "surface_topography"),
+                    help="C convention of files that record none")
     return p
 
 
 # ============================================================================ commands
+def _figure_maker(err):
+    """The scene figure maker, or None with a one-line note if matplotlib is missing."""
+    if importlib.util.find_spec("matplotlib") is None:
+        print("note: matplotlib is not installed: figures skipped (pip install matplotlib)",
+              file=err)
+        return None
+    from .figures.scene import make_scene_figure
+    return make_scene_figure
+
+
 def _cmd_run(a, out, err):
-    from .studies.scene import example_scene_path, load_scene, run_scene
+    from .studies.examples import example_scene_path
+    from .studies.load import load_scene
+    from .studies.run import run_scene
     if a.default and a.scene:
         raise CLIError("fastcontact run: give a scene or --default, not both")
     if not a.default and not a.scene:
         raise CLIError("fastcontact run: give a scene file (or --default)")
-    scene = load_scene(example_scene_path("default") if a.default else a.scene)
+    if Path(a.outdir).exists() and not Path(a.outdir).is_dir():
+        raise CLIError(f"fastcontact run: -o {a.outdir!r} is a file, not a folder")
+    scene = load_scene(example_scene_path("default") if a.default else a.scene,
+                       max_cases=a.max_cases)
     log = (lambda m: None) if a.quiet else (lambda m: print(m, file=err))
-    res = run_scene(scene, a.outdir, cache_dir=a.cache_dir, log=log)
-    print(f"results: {res['results_path']} ({len(res['results'])} rows)", file=out)
-    print(f"summary: {res['summary_path']}", file=out)
-    print(f"build record: {res['build_record_path']}", file=out)
-    for p in res["figures"]:
+    maker = None if (a.no_figures or not scene.figures) else _figure_maker(err)
+    res = run_scene(scene, a.outdir, cache_dir=a.cache_dir, log=log, make_figures=maker,
+                    progress=not a.quiet, progress_file=err)
+    print(f"results: {res.results_path} ({res.record['rows']} rows)", file=out)
+    print(f"summary: {res.summary_path}", file=out)
+    print(f"build record: {res.build_record_path}", file=out)
+    for p in res.figures:
         print(f"figure: {p}", file=out)
-    nerr = res["record"]["failed_rows"]
+    nerr = res.record["failed_rows"]
     if nerr:
         print(f"warning: {nerr} case(s) failed; see the 'error' column", file=err)
     return 0
 
 
 def _cmd_validate(a, out, err):
-    from .studies.scene import load_scene
-    sc = load_scene(a.scene)
-    n = len(sc.cases())
-    print(f"{sc.source}: valid {sc.kind} scene, {len(sc.surfaces)} surface(s) x {n} case(s), "
-          f"theories {', '.join(sc.theories)}", file=out)
+    from .studies.load import load_scene
+    sc = load_scene(a.scene, max_cases=a.max_cases)
+    print(f"{sc.source}: valid {sc.kind} scene, {len(sc.surfaces)} surface(s) x {sc.n_cases} "
+          f"case(s), theories {', '.join(sc.theories)}", file=out)
     return 0
 
 
 def _cmd_scenes(a, out, err):
-    from .studies.scene import example_scene_path, list_example_scenes
+    from .studies.examples import example_scene_path, list_example_scenes
     if a.name:
         print(example_scene_path(a.name).read_text(), file=out, end="")
         return 0
     for n in list_example_scenes():
-        p = example_scene_path(n)
-        first = p.read_text().splitlines()[0] if p.read_text() else ""
+        text = example_scene_path(n).read_text()
+        first = text.splitlines()[0] if text else ""
         print(f"{n:24s} {first.lstrip('# ').strip()}", file=out)
     return 0
 
@@ -259,7 +304,16 @@ def _cmd_tables_info(a, out, err):
 
 def _cmd_tables_defaults(a, out, err):
     from .tables.defaults import build_default_tables
-    built = build_default_tables(a.output_dir)
+    dirs = a.output_dir
+    if not dirs:
+        checkout = Path(__file__).resolve().parent.parent
+        if not ((checkout / "pyproject.toml").is_file() and (checkout / "tables").is_dir()):
+            raise CLIError("fastcontact tables defaults: not in a source checkout; give the "
+                           "folder to write to with -o DIR (the installed package is never "
+                           "written)")
+        dirs = [str(checkout / "tables")]
+    print(f"building the default tables into {', '.join(dirs)} ...", file=err)
+    built = build_default_tables(dirs)
     for name, t in built.items():
         e = t.info["interpolation_error"]
         print(f"{name}: {t.info['nodes']} nodes, built in {t.info['build_seconds']:.2f} s, "
@@ -296,7 +350,6 @@ FIGURE_MODULES = (
 
 
 def _cmd_figures(a, out, err):
-    import importlib
     outdir = Path(a.outdir)
     funcs = []
     for mod, fn in FIGURE_MODULES:   # import all first: a missing module fails before any work
@@ -341,8 +394,22 @@ def _cmd_roaddb_info(a, out, err):
     return 0
 
 
+def _dispatch(a):
+    if a.command == "tables":
+        return {"build": _cmd_tables_build, "info": _cmd_tables_info,
+                "defaults": _cmd_tables_defaults}.get(a.tables_command)
+    if a.command == "roaddb":
+        return {"generate": _cmd_roaddb_generate, "info": _cmd_roaddb_info}.get(a.roaddb_command)
+    return {"run": _cmd_run, "validate": _cmd_validate, "scenes": _cmd_scenes,
+            "sweep": _cmd_sweep, "figures": _cmd_figures}[a.command]
+
+
 def main(argv=None, out=None, err=None):
-    """Entry point; returns the exit code (0 ok, 1 failure, 2 bad input)."""
+    """Entry point; returns the exit code (0 ok, 1 failure, 2 bad input, 130 interrupted).
+
+    Bad input (SceneError, ValueError, a missing file, an unwritable folder) is reported in
+    one line on ``err``, never as a traceback.
+    """
     out = out or sys.stdout
     err = err or sys.stderr
     parser = build_parser()
@@ -351,25 +418,20 @@ def main(argv=None, out=None, err=None):
         if a.command is None:
             parser.print_help(out)
             return EXIT_BAD_INPUT
-        if a.command == "tables":
-            cmd = {"build": _cmd_tables_build, "info": _cmd_tables_info,
-                   "defaults": _cmd_tables_defaults}.get(a.tables_command)
-        elif a.command == "roaddb":
-            cmd = {"generate": _cmd_roaddb_generate, "info": _cmd_roaddb_info}.get(a.roaddb_command)
-        else:
-            cmd = {"run": _cmd_run, "validate": _cmd_validate, "scenes": _cmd_scenes,
-                   "sweep": _cmd_sweep, "figures": _cmd_figures}[a.command]
+        cmd = _dispatch(a)
         if cmd is None:
             raise CLIError(f"fastcontact {a.command}: give a subcommand (see --help)")
         return cmd(a, out, err)
-    except (ValueError, FileNotFoundError) as exc:
-        # bad input: SceneError, SweepError, CLIError, TableRangeError, ValueError from
-        # validation ... — one line, no traceback
-        msg = str(exc)
-        msg = " ".join(msg.split())
+    except (ValueError, OSError) as exc:
+        # bad input: SceneError, SweepError, CLIError, TableRangeError, a ValueError from
+        # validation, a missing file or an unwritable folder — one line, no traceback
+        msg = " ".join(str(exc).split())
         prefix = "" if msg.startswith("fastcontact") else "fastcontact: error: "
         print(prefix + msg, file=err)
         return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("fastcontact: interrupted", file=err)
+        return 130
 
 
 def _entry():  # pragma: no cover

@@ -22,10 +22,18 @@ import math
 import sys
 from pathlib import Path
 
+import matplotlib.ticker
 import numpy as np
-from fastcontact.figures.canvas import new_figure as _new_figure, save_png as _save_atomic
 
-__all__ = ["make_tire_figures", "tire_curve", "plot_tire_curves", "PAPER"]
+from .._core.vocab import column_name
+from ..contact.elasticity import effective_modulus
+from ..squeeze import squeeze_history, squeeze_out
+from ..squeeze.reduced import flat_separation
+from ..tables import Tables
+from ..tables.defaults import default_table_path
+from .canvas import new_figure as _new_figure, save_png as _save_atomic
+
+__all__ = ["make_tire_figures", "tire_curve", "plot_tire_curves", "draw_tire_curves", "PAPER"]
 
 PAPER = dict(p0=0.2e6, E=10e6, nu=0.5, R=0.02, eta=1e-3, rho=1000.0, u_start=1e-2,
              footprint_length=0.1, speed=30.0, theory="average", ratios=(1.1, 1.01, 1.001),
@@ -43,14 +51,11 @@ def tire_curve(tables, *, p0, E_star, R, eta, theory="average", u_start=PAPER["u
     The time axis spans from well before the film starts to thin to 10× the last ratio time
     (or to 1e3× the first if the fluid is trapped).
     """
-    from fastcontact.squeeze.reduced import flat_separation
-    from fastcontact.squeeze import squeeze_history, squeeze_out
     sq = squeeze_out(tables, p0=p0, E_star=E_star, R=R, eta=eta, theory=theory, u_start=u_start,
                      ratios=tuple(ratios), du=(du,), times=(), method="quad")
     row = sq.iloc[0]
-    from fastcontact.squeeze.tire import _pick
-    t_r = [float(row[c]) for c in _pick(sq, "t_ratio_", list(ratios))]
-    t_du = float(row[_pick(sq, "t_du_", [du])[0]])
+    t_r = [float(row[_column(sq, "t_ratio", r)]) for r in ratios]
+    t_du = float(row[_column(sq, "t_du", du)])
     u_inf = float(row["u_inf"])
     u0 = float(row["u_start"]) if "u_start" in sq else float(u_start)
     finite = [t for t in t_r + [t_du] if math.isfinite(t) and t > 0]
@@ -64,37 +69,64 @@ def tire_curve(tables, *, p0, E_star, R, eta, theory="average", u_start=PAPER["u
     flat = np.asarray(flat_separation(u0, t, p0, eta, R), float)
     return dict(label=label, t=t, u=u, du=u - u_inf, flat=flat, u_inf=u_inf, u_start=u0,
                 t_ratios=dict(zip(ratios, t_r)), t_du=t_du, du_level=du,
-                trapped=bool(row["trapped"]) if "trapped" in sq else False)
+                trapped=bool(row["trapped"]) if "trapped" in sq else False,
+                u_trap=float(row["u_trap"]) if "u_trap" in sq else math.nan)
 
 
-def plot_tire_curves(curves, path, quantity="u", title="", t_mark=None, t_mark_label=None):
-    """Log–log plot of ū(t) (``quantity="u"``) or Δu(t) (``"du"``) for several curves.
+def _column(frame, prefix, value):
+    """The squeeze_out column of a numbered output (column_name; former %g spelling)."""
+    name = column_name(prefix, value)
+    return name if name in frame else f"{prefix}_{float(value):g}"
 
-    Vertical dashed lines at the ratio times (1.1, 1.01, 1.001 from left to right), thin lines
-    for flat surfaces (ū plot), the Δu level (Δu plot) and an optional time mark
-    (e.g. the footprint time).
-    """
-    import matplotlib.ticker
-    fig = _new_figure(figsize=(6.4, 4.8))
-    ax = fig.subplots()
+
+def _curve_colors(n):
+    """Distinct colours for up to len(COLORS) curves, else a viridis ramp."""
+    if n <= len(COLORS):
+        return list(COLORS[:n])
+    import matplotlib
+    cmap = matplotlib.colormaps["viridis"]
+    return [cmap(x) for x in np.linspace(0.0, 0.9, n)]
+
+
+def _draw_curve(ax, c, col, quantity, label):
+    """One case: ū(t) or Δu(t) [mm, µm], the flat-surface law, ū∞ and, if the fluid is
+    trapped, its end state ū_trap (dash-dotted). Returns (ymin, ymax) of the curve."""
+    t = c["t"]
+    if quantity == "u":
+        y = c["u"] * 1e3
+        ax.plot(t, c["flat"] * 1e3, color=col, lw=0.6, alpha=0.8)
+        ax.axhline(c["u_inf"] * 1e3, color=col, lw=0.5, ls=":", alpha=0.7)
+        level = c.get("u_trap", math.nan) * 1e3
+    else:
+        y = c["du"] * 1e6
+        level = (c.get("u_trap", math.nan) - c["u_inf"]) * 1e6
+    ok = np.isfinite(y) & (y > 0)
+    ax.plot(t[ok], y[ok], color=col, lw=1.8 if label else 1.0, label=label or None)
+    if c.get("trapped") and np.isfinite(level) and level > 0:
+        ax.axhline(level, color=col, lw=1.0, ls="-.")
+        ax.annotate(rf"trapped: $\bar u_{{\rm trap}}$ = {c['u_trap'] * 1e6:.3g} µm",
+                    xy=(0.98, level), xycoords=("axes fraction", "data"), xytext=(0, 3),
+                    textcoords="offset points", ha="right", fontsize=7, color=col)
     styles = ("--", "-.", ":")
+    for j, tr in enumerate(c["t_ratios"].values()):
+        if math.isfinite(tr):
+            ax.axvline(tr, color=col, lw=0.8, ls=styles[j % 3], alpha=0.9)
+    if not ok.any():
+        return np.inf, 0.0
+    return y[ok].min(), y[ok].max()
+
+
+def draw_tire_curves(ax, curves, quantity="u", t_mark=None, t_mark_label=None, labels=True):
+    """Draw ū(t) (``quantity="u"``) or Δu(t) (``"du"``) of ``curves`` on ``ax`` (log–log).
+
+    Vertical lines at the ratio times (1.1, 1.01, 1.001 from left to right), thin lines for
+    flat surfaces (ū plot), ū_trap of trapped cases, the Δu level (Δu plot) and optional
+    time marks (e.g. the footprint time).
+    """
     ymin, ymax = np.inf, 0.0
-    for k, c in enumerate(curves):
-        col = COLORS[k % len(COLORS)]
-        t = c["t"]
-        if quantity == "u":
-            y = c["u"] * 1e3
-            ax.plot(t, c["flat"] * 1e3, color=col, lw=0.6, alpha=0.8)
-            ax.axhline(c["u_inf"] * 1e3, color=col, lw=0.5, ls=":", alpha=0.7)
-        else:
-            y = c["du"] * 1e6
-        ok = np.isfinite(y) & (y > 0)
-        ax.plot(t[ok], y[ok], color=col, lw=1.8, label=c["label"])
-        if ok.any():
-            ymin, ymax = min(ymin, y[ok].min()), max(ymax, y[ok].max())
-        for j, (r, tr) in enumerate(c["t_ratios"].items()):
-            if math.isfinite(tr):
-                ax.axvline(tr, color=col, lw=0.8, ls=styles[j % 3], alpha=0.9)
+    for c, col in zip(curves, _curve_colors(len(curves))):
+        lo, hi = _draw_curve(ax, c, col, quantity, c["label"] if labels else "")
+        ymin, ymax = min(ymin, lo), max(ymax, hi)
     if quantity == "du":
         lvl = curves[0]["du_level"] * 1e6 if curves else 1.0
         ax.axhline(lvl, color="k", lw=0.8, ls=":")
@@ -119,14 +151,22 @@ def plot_tire_curves(curves, path, quantity="u", title="", t_mark=None, t_mark_l
         lo, hi = ax.get_xlim()
         ax.set_xlim(lo, max(hi, 2.0 * max(marks)))
     ax.set_xlabel(r"squeeze time $t$ (s)")
+    ax.grid(True, which="major", lw=0.3, alpha=0.5)
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+
+
+def plot_tire_curves(curves, path, quantity="u", title="", t_mark=None, t_mark_label=None):
+    """Log–log plot of ū(t) (``quantity="u"``) or Δu(t) (``"du"``) for several curves
+    (see :func:`draw_tire_curves`), written atomically to ``path``."""
+    fig = _new_figure(figsize=(6.4, 4.8))
+    ax = fig.subplots()
+    draw_tire_curves(ax, curves, quantity, t_mark, t_mark_label)
     ax.plot([], [], color="0.4", lw=0.8, ls="--", label=r"$\bar u/\bar u_\infty$ = 1.1, 1.01, 1.001 (- -, -., :)")
     if quantity == "u":
         ax.plot([], [], color="0.4", lw=0.6, label="flat surfaces")
     ax.legend(loc="lower left", fontsize=8, frameon=False)
     if title:
         ax.set_title(title, fontsize=9)
-    ax.grid(True, which="major", lw=0.3, alpha=0.5)
-    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     return _save_atomic(fig, path)
 
 
@@ -135,12 +175,9 @@ def make_tire_figures(outdir, tables=None) -> list[Path]:
 
     ``tables``: optional {label: Tables}; default the embedded asphalt tables.
     """
-    from fastcontact.contact.elasticity import effective_modulus
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     if tables is None:
-        from fastcontact.studies.scene import default_table_path
-        from fastcontact.tables import Tables
         tables = {label: Tables.from_parquet(default_table_path(name)) for name, label in ROADS}
     E_star = effective_modulus(PAPER["E"], PAPER["nu"])
     curves = [tire_curve(T, p0=PAPER["p0"], E_star=E_star, R=PAPER["R"], eta=PAPER["eta"],

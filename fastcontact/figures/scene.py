@@ -1,0 +1,287 @@
+"""Figures of a scene run (``fastcontact run``): every case drawn, small multiples when many.
+
+:func:`make_scene_figure` is the figure maker the CLI hands to
+:func:`fastcontact.studies.run.run_scene`. ū(t) and Δu(t) figures (squeeze and tire studies)
+draw one panel per surface and one curve per distinct case, with trapped cases' end state
+ū_trap; ``t_star`` and ``leak_rate`` draw one line per combination of the other axes, trapped
+or sealed cases marked at the panel edge. One style for every figure (:func:`_finish`).
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..seal import hertz_contact, seal_profile
+from ..squeeze.tire import profile_factors
+from .canvas import new_figure, save_png
+from .tire_figures import _curve_colors, draw_tire_curves, tire_curve
+
+__all__ = ["make_scene_figure", "MAX_CURVES_PER_PANEL", "UNIT_LABELS"]
+
+#: panels show at most this many curves each; more cases are thinned evenly and the panel
+#: title says "n of m cases"
+MAX_CURVES_PER_PANEL = 60
+#: display scale and unit of the case parameters in labels
+UNIT_LABELS = {"p0": (1e6, "MPa"), "E": (1e6, "MPa"), "E_star": (1e6, "MPa"),
+               "E2": (1e6, "MPa"), "eta": (1e-3, "mPa s"), "R": (1e-2, "cm"),
+               "u_start": (1e-3, "mm"), "dp": (1e3, "kPa"), "L": (1e-3, "mm"),
+               "L_y": (1e-3, "mm"), "p_b": (1e3, "kPa"), "speed": (1.0, "m/s"),
+               "footprint_length": (1e-3, "mm"), "f_N": (1e3, "N/mm"), "rho": (1.0, "kg/m^3")}
+_SI_UNIT = {"p0": "Pa", "E": "Pa", "E_star": "Pa", "E2": "Pa", "eta": "Pa s", "R": "m",
+            "u_start": "m", "dp": "Pa", "p_b": "Pa", "L": "m", "L_y": "m", "rho": "kg/m^3",
+            "speed": "m/s", "footprint_length": "m", "f_N": "N/m"}
+_SQUEEZE_KEYS = ("theory", "p0", "E", "nu", "E2", "nu2", "E_star", "eta", "R", "u_start")
+_SEAL_COLORS = ("tab:blue", "tab:orange", "tab:red")
+
+
+# =========================================================================== helpers
+def _surface_label(scene, name):
+    spec = scene.surfaces.get(name)
+    return (spec.label if spec is not None and spec.label else name)
+
+
+def _case_label(scene, row, keys=None):
+    """The varying parameters of a case, with units (``p0 = 0.2 MPa, emt``)."""
+    parts = []
+    for k, v in scene.axes.items():
+        if len(v) > 1 and (keys is None or k in keys):
+            if k == "theory":
+                parts.append(str(row[k]))
+            elif k in UNIT_LABELS:
+                f, u = UNIT_LABELS[k]
+                parts.append(f"{k} = {float(row[k]) / f:.3g} {u}")
+            else:
+                parts.append(f"{k} = {float(row[k]):.3g}")
+    return ", ".join(parts)
+
+
+def _grid(fig, n):
+    """``n`` axes in a grid of up to 3 columns (small multiples)."""
+    ncols = 1 if n == 1 else min(3, n)
+    nrows = math.ceil(n / ncols)
+    axs = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
+    for ax in axs[n:]:
+        ax.set_visible(False)
+    return axs[:n]
+
+
+def _figure(n_panels):
+    ncols = 1 if n_panels == 1 else min(3, n_panels)
+    nrows = math.ceil(n_panels / ncols)
+    return new_figure(figsize=(6.4 if ncols == 1 else 4.6 * ncols, 4.8 if nrows == 1 else 3.8 * nrows))
+
+
+def _thin(items, limit=MAX_CURVES_PER_PANEL):
+    """``items`` evenly thinned to ``limit`` (first and last kept) and the original count."""
+    if len(items) <= limit:
+        return items, len(items)
+    idx = np.unique(np.linspace(0, len(items) - 1, limit).round().astype(int))
+    return [items[i] for i in idx], len(items)
+
+
+def _finish(fig, axs, title, legend_loc="best"):
+    """The one style of every run figure: small legends, light grid, title on top."""
+    for ax in axs:
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7, frameon=False, loc=legend_loc)
+        ax.grid(True, which="major", lw=0.3, alpha=0.5)
+    fig.suptitle(title, fontsize=9)
+
+
+def _sweep_axis(scene, candidates=None):
+    for k, v in scene.axes.items():
+        if k != "theory" and len(v) > 1 and (candidates is None or k in candidates):
+            return k
+    return None
+
+
+# =========================================================================== ū(t), Δu(t)
+def _p_eval(scene, row):
+    if "p_eval" in row:
+        return float(row["p_eval"])
+    if scene.kind == "tire":
+        peak = profile_factors(scene.fixed["pressure_profile"])[1]
+        return float(row["p0"]) * (peak if scene.fixed["pressure_model"] == "peak" else 1.0)
+    return float(row["p0"])
+
+
+def _curve(scene, T, row):
+    ratios = scene.fixed.get("ratios") or (1.1, 1.01, 1.001)
+    du = scene.fixed.get("du_complete") or (scene.fixed.get("du") or (1e-6,))[0]
+    u0 = float(row["u_start"]) if "u_start" in row and np.isfinite(float(row["u_start"])) else None
+    return tire_curve(T, p0=_p_eval(scene, row), E_star=float(row["E_star"]), R=float(row["R"]),
+                      eta=float(row["eta"]), theory=row["theory"], u_start=u0, ratios=ratios,
+                      du=du, label=_case_label(scene, row, _SQUEEZE_KEYS))
+
+
+def _history_figure(scene, fig_name, tables, results, path):
+    ok = results[results["error"] == ""]
+    keys = ["surface"] + [c for c in _SQUEEZE_KEYS if c in ok]
+    ok = ok.drop_duplicates(subset=keys)
+    names = list(dict.fromkeys(ok["surface"]))
+    fig = _figure(max(len(names), 1))
+    axs = _grid(fig, max(len(names), 1))
+    quantity = "du" if fig_name == "du_of_t" else "u"
+    t_mark = None
+    if scene.kind == "tire":
+        t_mark = sorted(set((results["footprint_length"] / results["speed"]).round(12)))
+    for ax, name in zip(axs, names):
+        rows, total = _thin([r for _, r in ok[ok["surface"] == name].iterrows()])
+        curves = [_curve(scene, tables[name], r) for r in rows]
+        draw_tire_curves(ax, curves, quantity, t_mark,
+                         "time in footprint:" if t_mark else None, labels=len(curves) <= 8)
+        shown = f" ({len(rows)} of {total} cases)" if total > len(rows) else ""
+        ax.set_title(_surface_label(scene, name) + shown, fontsize=8)
+        if len(curves) > 8:
+            ax.annotate(f"{len(curves)} cases, colour: first (purple) → last (yellow) of "
+                        f"{_case_label(scene, rows[0], _SQUEEZE_KEYS) or 'the cases'} …",
+                        xy=(0.02, 0.02), xycoords="axes fraction", fontsize=6)
+    ax0 = axs[0]
+    ax0.plot([], [], color="0.4", lw=0.8, ls="--",
+             label=r"$\bar u/\bar u_\infty$ = 1.1, 1.01, 1.001 (- -, -., :)")
+    ax0.plot([], [], color="0.4", lw=1.0, ls="-.", label=r"trapped: $\bar u_{\rm trap}$")
+    if quantity == "u":
+        ax0.plot([], [], color="0.4", lw=0.6, label="flat surfaces")
+    _finish(fig, axs, scene.title, legend_loc="lower left")
+    return save_png(fig, path)
+
+
+# =========================================================================== t*(x)
+def _t_star_figure(scene, results, path):
+    ok = results[results["error"] == ""]
+    x = _sweep_axis(scene) or "p0"
+    others = [k for k, v in scene.axes.items() if len(v) > 1 and k not in (x,)]
+    fig = _figure(1)
+    ax = fig.subplots()
+    groups = list(ok.groupby(["surface", *others], sort=False))
+    colors = _curve_colors(len(groups))
+    top = np.nanmax(ok["t_star"].to_numpy(float)[np.isfinite(ok["t_star"].to_numpy(float))],
+                    initial=1.0)
+    for col, ((name, *_), g) in zip(colors, groups):
+        gg = g.sort_values(x)
+        xv, y = gg[x].to_numpy(float), gg["t_star"].to_numpy(float)
+        fin = np.isfinite(y) & (y > 0)
+        lab = ", ".join(s for s in (_surface_label(scene, name),
+                                    _case_label(scene, gg.iloc[0], others)) if s)
+        ax.plot(xv[fin], y[fin], "o-", ms=3, color=col, label=lab if len(groups) <= 12 else None)
+        if (~fin).any():
+            ax.plot(xv[~fin], np.full((~fin).sum(), top * 3), "^", mfc="none", color=col, ms=6)
+    if (~np.isfinite(ok["t_star"].to_numpy(float))).any():
+        ax.plot([], [], "^", mfc="none", color="0.3", label=r"trapped ($t^* = \infty$)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(f"{x} ({_SI_UNIT.get(x, '-')})")
+    ax.set_ylabel(r"squeeze-out time $t^*$ (s), $\bar u(t^*) = 1.01\,\bar u_\infty$")
+    _finish(fig, [ax], scene.title)
+    return save_png(fig, path)
+
+
+# =========================================================================== seals
+def _seal_p_ref(scene, rows):
+    """p0 of a flat ring, or the Hertz peak pressure, for each row [Pa]."""
+    if scene.fixed.get("profile") == "hertz":
+        return np.asarray(hertz_contact(rows["R"].to_numpy(float), rows["f_N"].to_numpy(float),
+                                        rows["E_star"].to_numpy(float))[1], float).ravel()
+    return rows["p0"].to_numpy(float)
+
+
+def _leak_figure(scene, results, path):
+    ok = results[results["error"] == ""]
+    others = [k for k, v in scene.axes.items() if len(v) > 1 and k != "dp"]
+    fig = _figure(1)
+    ax = fig.subplots()
+    groups = list(ok.groupby(["surface", *others], sort=False))
+    sealed = False
+    for col, ((name, *_), g) in zip(_curve_colors(len(groups)), groups):
+        gg = g.sort_values("dp")
+        Q = gg["Q"].to_numpy(float)
+        m = np.isfinite(Q) & (Q > 0)
+        x = gg["dp"].to_numpy(float) / _seal_p_ref(scene, gg)
+        lab = ", ".join(s for s in (_surface_label(scene, name),
+                                    _case_label(scene, gg.iloc[0], others)) if s)
+        ax.plot(x[m], Q[m], "o-", ms=3, color=col, label=lab if len(groups) <= 12 else None)
+        if (~m).any():
+            sealed = True
+            ax.plot(x[~m], np.full((~m).sum(), np.nanmin(Q[m], initial=1e-20) / 3), "v",
+                    mfc="none", color=col, ms=6)
+    if sealed:
+        ax.plot([], [], "v", mfc="none", color="0.3", label="Q = 0 (percolated: sealed)")
+    ax.set_yscale("log")
+    ax.set_xlabel(r"$\Delta p / p_0$" + (r" ($p_0$: Hertz peak pressure)"
+                                         if scene.fixed.get("profile") == "hertz" else ""))
+    ax.set_ylabel(r"leak rate $Q$ (m$^3$/s)")
+    _finish(fig, [ax], scene.title)
+    return save_png(fig, path)
+
+
+def _seal_profile_kwargs(scene, row, dp):
+    kw = dict(dp=dp, L_y=float(row["L_y"]), E_star=float(row["E_star"]), eta=float(row["eta"]),
+              theory=row["theory"], alpha_cj=float(row["alpha_cj"]), p_b=float(row["p_b"]),
+              profile=scene.fixed.get("profile", "uniform"))
+    if scene.fixed.get("profile") == "hertz":
+        kw.update(R=float(row["R"]), f_N=float(row["f_N"]))
+    else:
+        kw.update(p0=float(row["p0"]), L=float(row["L"]))
+    return kw
+
+
+def _profiles_figure(scene, tables, results, path):
+    ok = results[results["error"] == ""]
+    names = list(dict.fromkeys(ok["surface"]))
+    fig = _figure(max(len(names), 1))
+    axs = _grid(fig, max(len(names), 1))
+    for ax, name in zip(axs, names):
+        row = ok[ok["surface"] == name].iloc[0]
+        ax2 = ax.twinx()
+        for j, frac in enumerate((0.0, 0.5, 0.9)):
+            dp = frac * float(_seal_p_ref(scene, row.to_frame().T)[0])
+            prof = seal_profile(tables[name], **_seal_profile_kwargs(scene, row, dp))
+            x = prof["x"].to_numpy(float) * 1e3
+            ax.plot(x, prof["p_cont"].to_numpy(float) / 1e3, color=_SEAL_COLORS[j],
+                    label=rf"$p_{{\rm cont}}$, $\Delta p/p_0$ = {frac:g}")
+            ucol = "u" if "u" in prof else [c for c in prof.columns if c.startswith("u")][0]
+            ax2.plot(x, prof[ucol].to_numpy(float) * 1e6, color=_SEAL_COLORS[j], ls="--")
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel(r"contact pressure $p_{\rm cont}$ (kPa)")
+        ax2.set_ylabel(r"separation $\bar u$ (µm), dashed")
+        ax.set_title(f"{_surface_label(scene, name)}: {_case_label(scene, row) or 'first case'}",
+                     fontsize=8)
+    _finish(fig, axs, scene.title, legend_loc="upper center")
+    return save_png(fig, path)
+
+
+# =========================================================================== entry
+def make_scene_figure(scene, fig, tables, results, figdir) -> Path:
+    """Draw figure ``fig`` of a scene run into ``figdir/<kind>_<fig>.png``.
+
+    Parameters
+    ----------
+    scene : fastcontact.studies.scene.Scene
+    fig : str
+        One of the kind's figures: ``u_of_t``, ``t_star`` (squeeze), ``u_of_t``,
+        ``du_of_t`` (tire), ``leak_rate``, ``profiles`` (seal).
+    tables : dict
+        Surface name → Tables.
+    results : pandas.DataFrame
+        The run's rows (every surface).
+    figdir : path-like
+
+    Returns
+    -------
+    pathlib.Path
+        The PNG written (atomically).
+    """
+    figdir = Path(figdir)
+    figdir.mkdir(parents=True, exist_ok=True)
+    path = figdir / f"{scene.kind}_{fig}.png"
+    if fig in ("u_of_t", "du_of_t"):
+        return _history_figure(scene, fig, tables, results, path)
+    if fig == "t_star":
+        return _t_star_figure(scene, results, path)
+    if fig == "leak_rate":
+        return _leak_figure(scene, results, path)
+    if fig == "profiles":
+        return _profiles_figure(scene, tables, results, path)
+    raise ValueError(f"fig = {fig!r} is invalid: no such scene figure")

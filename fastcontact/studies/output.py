@@ -1,0 +1,160 @@
+"""Files of a run: Parquet with the unit of every column, streamed in blocks and renamed into
+place; JSON and text written atomically; a summary with units."""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+import pyarrow.parquet as pq
+
+from .._core.io import atomic_path, write_bytes_atomic
+from .._core.vocab import METADATA_KEY
+
+__all__ = ["ParquetStream", "write_parquet_atomic", "write_json_atomic", "json_default",
+           "column_summary"]
+
+
+def json_default(o):
+    """JSON encoder for numpy scalars and arrays, paths, tuples and records with to_dict()."""
+    if isinstance(o, (np.floating, np.integer, np.bool_)):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, Path):
+        return str(o)
+    if isinstance(o, tuple):
+        return list(o)
+    if hasattr(o, "to_dict"):
+        return o.to_dict()
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+_json_default = json_default
+
+
+def _atomic_write_bytes(path, data: bytes):
+    return write_bytes_atomic(path, data)
+
+
+def write_json_atomic(path, obj) -> Path:
+    """Write ``obj`` as indented, key-sorted JSON to ``path`` atomically."""
+    return write_bytes_atomic(Path(path), json.dumps(obj, indent=2, sort_keys=True,
+                                                     default=json_default).encode())
+
+
+def _table(df, units, metadata, schema=None):
+    """Arrow table of ``df`` with the unit of every column as field metadata."""
+    table = pa.Table.from_pandas(df, preserve_index=False)
+    if schema is not None:
+        return table.cast(schema)
+    units = dict(units or {}, **df.attrs.get("units", {}))
+    fields = [f.with_metadata({"unit": units.get(f.name, "")}) for f in table.schema]
+    meta = dict(table.schema.metadata or {})
+    if metadata is not None:
+        meta[METADATA_KEY] = json.dumps(dict(metadata, units={f.name: units.get(f.name, "")
+                                                              for f in fields}),
+                                        sort_keys=True, default=json_default).encode()
+    return table.cast(pa.schema(fields, metadata=meta))
+
+
+def write_parquet_atomic(df, path, metadata: dict | None = None, units: dict | None = None):
+    """Write ``df`` to ``path`` atomically, with JSON ``metadata`` under the ``fastcontact``
+    key and each column's unit (``units``, else ``df.attrs["units"]``) as field metadata."""
+    path = Path(path)
+    table = _table(df, units, metadata)
+    with atomic_path(path) as tmp:
+        pq.write_table(table, tmp)
+    return path
+
+
+class ParquetStream:
+    """Write a Parquet file block by block: a temporary file beside ``path``, renamed into
+    place by :meth:`close` (a reader never sees a partial file).
+
+    Parameters
+    ----------
+    path : path-like
+    metadata : dict
+        Stored as JSON under the ``fastcontact`` key (the units are added).
+    units : dict
+        SI unit of each column (field metadata ``unit``).
+    """
+
+    def __init__(self, path, metadata=None, units=None):
+        self.path = Path(path)
+        self.metadata, self.units = metadata, units
+        self.writer, self.schema, self.rows = None, None, 0
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd, self.tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp",
+                                        dir=self.path.parent)
+        os.close(fd)
+
+    def write(self, df):
+        """Append the rows of ``df`` (same columns and types as the first block)."""
+        table = _table(df, self.units, self.metadata, self.schema)
+        if self.writer is None:
+            self.schema = table.schema
+            self.writer = pq.ParquetWriter(self.tmp, self.schema)
+        self.writer.write_table(table)
+        self.rows += table.num_rows
+
+    def close(self) -> Path:
+        """Finish the file and move it into place."""
+        if self.writer is None:
+            raise ValueError(f"{self.path}: no rows were written")
+        self.writer.close()
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(self.tmp, 0o666 & ~umask)
+        os.replace(self.tmp, self.path)
+        return self.path
+
+    def abort(self):
+        """Drop the temporary file."""
+        if self.writer is not None:
+            self.writer.close()
+        if os.path.exists(self.tmp):
+            os.unlink(self.tmp)
+
+
+def column_summary(path, columns, groups):
+    """Per-group min / median / max (numbers) or true-count (flags) of ``columns`` of a
+    Parquet file, read one column at a time.
+
+    Parameters
+    ----------
+    path : path-like
+    columns : list of str
+    groups : list of (name, start, stop)
+        Row ranges of the groups (the surfaces, written one after another).
+
+    Returns
+    -------
+    dict
+        ``{group: [(column, kind, values)]}`` with kind ``"num"`` → (min, median, max) of the
+        finite values or None, ``"bool"`` → (true count, rows).
+    """
+    pf = pq.ParquetFile(path)
+    names = set(pf.schema_arrow.names)
+    out = {g: [] for g, _, _ in groups}
+    for c in columns:
+        if c not in names:
+            continue
+        col = pf.read(columns=[c]).column(c)
+        if pa.types.is_boolean(col.type):
+            for g, a, b in groups:
+                part = col.slice(a, b - a)
+                out[g].append((c, "bool", (int(pc.sum(part).as_py() or 0), b - a)))
+        elif pa.types.is_floating(col.type):
+            v = col.to_numpy()
+            for g, a, b in groups:
+                w = v[a:b]
+                w = w[np.isfinite(w)]
+                out[g].append((c, "num", (w.min(), np.median(w), w.max()) if w.size else None))
+        del col
+    return out
