@@ -1,0 +1,363 @@
+"""Per-case quadrature engine of the squeeze-out time (``method="quad"``, and the fall-back of
+the fast path for trapped-fluid rows).
+
+Reduced units: v = ū/h_rms, π = p/E*, σ̄ = 12ησ_eff/h_rms³, t̃ = t/τ0 with
+τ0 = 3ηR²/(2 h_rms² p0); dv/dt̃ = -σ̄(π_c(v)) (1 - π_c(v)/π0) (Lorenz & Persson 2010,
+eqs. (18), (19), (23); doi:10.1140/epje/i2010-10626-9). Times are quadratures in
+w = ln(v - v_b), never time stepping. Every kernel takes the tables' kernel record ``tab``
+and the model record ``mp`` (:class:`~fastcontact.squeeze.model.ModelPar`).
+"""
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit, prange
+
+from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
+
+__all__ = ["Quad", "Cases", "Targets", "SqOut", "ST_OK", "ST_TRAPPED", "ST_OUT", "ST_BELOW",
+           "ST_OVERFLOW", "STATUS_NAMES"]
+
+#: Gauss–Legendre rule and panel width in w = ln(v - v_b)
+Quad = namedtuple("Quad", "glx glw width")
+#: one row per case (SI): p0 [Pa], E [Pa], R [m], eta [Pa s], us = u_start [m] (NaN: default)
+Cases = namedtuple("Cases", "p0 E R eta us")
+#: targets shared by all cases: ratios ū/ū∞, dvs = Δu/h_rms, times [s] (shape (nt, 1) shared
+#: or (nt, n) per case, ascending along axis 0)
+Targets = namedtuple("Targets", "ratios dvs times")
+#: outputs, one column per case: T (1 + nr + nd, n) times [s] (t_star first), U (nt, n) ū at
+#: the times [m], then per case u_inf, u_start, t_relax, u_trap, t_trap [SI],
+#: flf (fluid load fraction), tau0 [s], status (int8)
+SqOut = namedtuple("SqOut", "T U u_inf u_start t_relax u_trap t_trap flf tau0 status")
+
+# status codes (STATUS_NAMES gives the readable value of the ``status`` column)
+ST_OK, ST_TRAPPED, ST_OUT, ST_BELOW, ST_OVERFLOW = 0, 1, 2, 3, 4
+STATUS_NAMES = ("ok", "trapped", "out_of_table", "start_below_equilibrium", "overflow")
+
+
+@njit(cache=True)
+def _state(tab, mp, v):
+    """(ln π_c, σ̄) at separation v [h_rms]: tables, or the analytic tail above v_top."""
+    v_top = mp.v_top
+    if v > v_top:
+        y = v + mp.d
+        return mp.x_min - (v - v_top) / mp.u0, y * (y * y - mp.c)
+    lnp = k_lnp_of_lnu(tab, math.log(v))
+    if lnp != lnp:
+        return lnp, math.nan
+    if lnp >= mp.x_trap:
+        return lnp, 0.0
+    return lnp, k_sigma_of_lnp(tab, lnp)
+
+
+@njit(cache=True)
+def _lnv_of_lnp(tab, mp, x):
+    """ln v with π_c(v) = e^x exactly for the model's p_cont(v) (Newton on k_lnp_of_lnu)."""
+    if x <= mp.x_min:
+        return math.log(mp.v_top + mp.u0 * (mp.x_min - x))
+    y = k_lnu_of_lnp(tab, x)
+    if y != y:
+        return y
+    hh = 1e-6
+    for _ in range(6):
+        f = k_lnp_of_lnu(tab, y) - x
+        if f == 0.0:
+            break
+        fp = k_lnp_of_lnu(tab, y + hh)
+        fm = k_lnp_of_lnu(tab, y - hh)
+        if fp == fp and fm == fm:
+            slope = (fp - fm) / (2.0 * hh)
+        elif fp == fp:
+            slope = (fp - (f + x)) / hh
+        else:
+            slope = ((f + x) - fm) / hh
+        if not (slope < 0.0):
+            break
+        step = f / slope
+        y -= step
+        if abs(step) < 1e-15:
+            break
+    return y
+
+
+@njit(cache=True)
+def _dlnv_dlnp(tab, mp, x):
+    """|d ln v / d ln π| of the model's p_cont(v) at ln π = x (central difference)."""
+    hh = 1e-6
+    if x + hh > mp.x_max:
+        return abs(_lnv_of_lnp(tab, mp, x) - _lnv_of_lnp(tab, mp, x - hh)) / hh
+    if x - hh < mp.x_min:
+        return abs(_lnv_of_lnp(tab, mp, x + hh) - _lnv_of_lnp(tab, mp, x)) / hh
+    return abs(_lnv_of_lnp(tab, mp, x + hh) - _lnv_of_lnp(tab, mp, x - hh)) / (2.0 * hh)
+
+
+@njit(cache=True)
+def _dtdw(tab, mp, x0, vb, w):
+    """dt̃/dw at w = ln(v - vb): (v - vb) / (σ̄ (1 - π_c/π0)); 0 where σ̄ = 0 (trapped)."""
+    e = math.exp(w)
+    lnp, sig = _state(tab, mp, vb + e)
+    if not (sig > 0.0):
+        return 0.0
+    d = -math.expm1(lnp - x0)
+    if d <= 1e-300:
+        d = 1e-300
+    return e / (sig * d)
+
+
+@njit(cache=True)
+def _seg(tab, mp, x0, vb, w1, w2, quad):
+    """∫_{w1}^{w2} dt̃/dw dw, composite Gauss–Legendre, panels of width <= width."""
+    if not (w2 > w1):
+        return 0.0
+    glx, glw, width = quad.glx, quad.glw, quad.width
+    m = int(math.ceil((w2 - w1) / width))
+    if m < 1:
+        m = 1
+    hw = (w2 - w1) / m
+    s = 0.0
+    for k in range(m):
+        mid = w1 + (k + 0.5) * hw
+        acc = 0.0
+        for j in range(glx.size):
+            acc += glw[j] * _dtdw(tab, mp, x0, vb, mid + 0.5 * hw * glx[j])
+        s += acc * 0.5 * hw
+    return s
+
+
+@njit(cache=True)
+def _tail_int(c, a, b):
+    """∫_a^b dv/(v³ - c v) (b may be inf) — the σ̄ tail with π_c/π0 negligible."""
+    ia2 = 1.0 / (a * a)
+    ib2 = 0.0 if b == math.inf else 1.0 / (b * b)
+    if abs(c) * ia2 < 1e-6:
+        return (0.5 * (ia2 - ib2) + 0.25 * c * (ia2 * ia2 - ib2 * ib2)
+                + c * c / 6.0 * (ia2 * ia2 * ia2 - ib2 * ib2 * ib2))
+    lb = 0.0 if b == math.inf else math.log1p(-c * ib2)
+    return (lb - math.log1p(-c * ia2)) / (2.0 * c)
+
+
+@njit(cache=True)
+def _time(tab, mp, x0, vb, v_lo, v_hi, quad):
+    """t̃ to go from v_hi (may be inf) down to v_lo > vb."""
+    if not (v_hi > v_lo):
+        return 0.0
+    total = 0.0
+    v_ext = mp.v_ext
+    if v_hi > v_ext:
+        a = v_lo if v_lo > v_ext else v_ext
+        total += _tail_int(mp.c, a + mp.d, v_hi + mp.d)
+        if v_lo >= v_ext:
+            return total
+        v_hi = v_ext
+    return total + _seg(tab, mp, x0, vb, math.log(v_lo - vb), math.log(v_hi - vb), quad)
+
+
+@njit(cache=True)
+def _v_at_time(tab, mp, x0, vb, v_floor, vs, t_prev, w_prev, t_target, quad):
+    """Solve t̃(vs → v) = t_target for v (vb < v_floor <= v <= vs), continuing from the
+    previous solution (t_prev at w_prev = ln(v_prev - vb)). Returns (v, t_reached, w).
+
+    Safeguarded Newton in w with incremental quadrature; v_floor is v∞ (→ returned for
+    t = inf) or v_trap (→ returned once t̃ >= the trap time)."""
+    if t_target <= t_prev:
+        return vb + math.exp(w_prev), t_prev, w_prev
+    w = w_prev
+    t = t_prev
+    if v_floor > vb:
+        w_min = math.log(v_floor - vb)
+    else:
+        w_min = math.log(vb * 1e-13 + 1e-300)
+    for _ in range(200):
+        g = _dtdw(tab, mp, x0, vb, w)
+        rem = t_target - t
+        if g > 0.0:
+            step = rem / g
+        else:
+            step = 1.0
+        if step > 2.0:
+            step = 2.0
+        wn = w - step
+        if wn < w_min:
+            wn = w_min
+        dt = _seg(tab, mp, x0, vb, wn, w, quad)
+        if t + dt > t_target and wn < w - 1e-15:
+            # overshoot: shrink until inside (monotone: halve the step)
+            lo_w = wn
+            hi_w = w
+            for _k in range(100):
+                g = _dtdw(tab, mp, x0, vb, w)
+                step = (t_target - t) / g if g > 0.0 else 0.5 * (hi_w - lo_w)
+                wc = w - step
+                if not (lo_w < wc < hi_w):
+                    wc = 0.5 * (lo_w + hi_w)
+                dtc = _seg(tab, mp, x0, vb, wc, w, quad)
+                if t + dtc > t_target:
+                    lo_w = wc
+                else:
+                    hi_w = wc
+                    t += dtc
+                    w = wc
+                if abs(t - t_target) <= 1e-14 * t_target or hi_w - lo_w < 1e-14:
+                    return vb + math.exp(w), t, w
+            return vb + math.exp(w), t, w
+        t += dt
+        w = wn
+        if abs(t - t_target) <= 1e-14 * t_target:
+            break
+        if w <= w_min:
+            # floor reached: trapped (v_trap reached in finite time) or v∞ to precision
+            return v_floor if v_floor > vb else vb, t_target, w
+    return vb + math.exp(w), t, w
+
+
+@njit(cache=True)
+def _nan_row(out, i, x_out):
+    """Every computed column of row i NaN (state cannot be computed)."""
+    for k in range(out.T.shape[0]):
+        out.T[k, i] = math.nan
+    for k in range(out.U.shape[0]):
+        out.U[k, i] = math.nan
+    out.u_inf[i] = math.nan
+    out.t_relax[i] = math.nan
+    out.u_trap[i] = math.nan
+    out.t_trap[i] = math.nan
+    out.flf[i] = math.nan
+
+
+@njit(cache=True)
+def _case_state(tab, mp, x0, vs_in, tau, h, i, out):
+    """(v∞, v_start, v_b, trapped) of one case; writes the per-case state columns."""
+    vinf = math.exp(_lnv_of_lnp(tab, mp, x0))
+    vs = vs_in
+    if vs != vs:  # default start: p_cont(v_start) = DEFAULT_P_START p0
+        vs = math.exp(_lnv_of_lnp(tab, mp, x0 + mp.lnp_start))
+    trapped = x0 >= mp.x_trap
+    out.u_inf[i] = vinf * h
+    out.u_start[i] = vs * h
+    if trapped:
+        vb = mp.v_trap
+        out.status[i] = ST_TRAPPED
+        out.u_trap[i] = vb * h
+        out.flf[i] = -math.expm1(mp.x_trap - x0)
+        out.t_relax[i] = math.nan
+    else:
+        vb = vinf
+        out.status[i] = ST_OK
+        out.u_trap[i] = math.nan
+        out.flf[i] = 0.0
+        out.t_relax[i] = tau * vinf * _dlnv_dlnp(tab, mp, x0) / k_sigma_of_lnp(tab, x0)
+    return vinf, vs, vb, trapped
+
+
+@njit(cache=True)
+def _case_targets(tab, mp, x0, vinf, vs, vb, trapped, tg, tau, quad, i, out):
+    """Times to t_star, the ratios and the Δu targets: one downward pass from the start."""
+    nt = out.T.shape[0]
+    nr = tg.ratios.size
+    vts = np.empty(nt)
+    for k in range(nt):
+        if k == 0:
+            vts[k] = 1.01 * vinf
+        elif k <= nr:
+            vts[k] = tg.ratios[k - 1] * vinf
+        else:
+            vts[k] = vinf + tg.dvs[k - 1 - nr]
+    order = np.argsort(-vts)
+    v_cur = vs
+    t_cur = 0.0
+    for kk in range(nt):
+        k = order[kk]
+        vt = vts[k]
+        if vt >= vs:
+            out.T[k, i] = 0.0
+        elif trapped and (vt <= vb or vs <= vb):
+            out.T[k, i] = math.inf
+        else:
+            if vt < v_cur:
+                t_cur += _time(tab, mp, x0, vb, vt, v_cur, quad)
+                v_cur = vt
+            out.T[k, i] = tau * t_cur
+
+
+@njit(cache=True)
+def _case_times(tab, mp, x0, vs, vb, trapped, tg, tau, h, quad, i, out):
+    """Trap time and ū at the (ascending) times of row i."""
+    t_trap = math.inf
+    if trapped:
+        if vs <= vb:
+            t_trap = 0.0
+        else:
+            # below w_lo = ln(v_trap) - 30 the integrand is e^w x const: closed form
+            w_lo = math.log(vb) - 30.0
+            t_trap = (_dtdw(tab, mp, x0, vb, w_lo)
+                      + _time(tab, mp, x0, vb, vb + math.exp(w_lo), vs, quad))
+    out.t_trap[i] = tau * t_trap
+    tp = 0.0
+    wp = math.log(vs - vb) if vs > vb else -math.inf
+    col = i if tg.times.shape[1] > 1 else 0
+    for k in range(out.U.shape[0]):
+        tk = tg.times[k, col] / tau
+        if vs <= vb:
+            out.U[k, i] = vs * h
+        elif tk == math.inf or (trapped and tk >= t_trap):
+            out.U[k, i] = vb * h
+        else:
+            v, tp, wp = _v_at_time(tab, mp, x0, vb, vb, vs, tp, wp, tk, quad)
+            out.U[k, i] = v * h
+
+
+@njit(cache=True)
+def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
+    """Everything for one case by quadrature, written in SI to column i of ``out``."""
+    if not (mp.x_min <= x0 <= mp.x_max):
+        _nan_row(out, i, x0)
+        out.u_start[i] = vs_in * h
+        out.status[i] = ST_OUT
+        return
+    vinf, vs, vb, trapped = _case_state(tab, mp, x0, vs_in, tau, h, i, out)
+    if not trapped and not (vs > vinf):
+        _nan_row(out, i, x0)
+        out.u_inf[i] = vinf * h
+        out.status[i] = ST_BELOW
+        return
+    _case_targets(tab, mp, x0, vinf, vs, vb, trapped, tg, tau, quad, i, out)
+    _case_times(tab, mp, x0, vs, vb, trapped, tg, tau, h, quad, i, out)
+
+
+@njit(parallel=True, cache=True)
+def quad_kernel(tab, mp, cs, h, tg, quad, out):
+    """method="quad": every case by per-case quadrature (one prange pass)."""
+    for i in prange(cs.p0.size):
+        tau = 3.0 * cs.eta[i] * cs.R[i] * cs.R[i] / (2.0 * h * h * cs.p0[i])
+        out.tau0[i] = tau
+        quad_case(tab, mp, math.log(cs.p0[i] / cs.E[i]), cs.us[i] / h, tg, tau, h, quad, i, out)
+
+
+@njit(cache=True)
+def p_of_v_kernel(tab, mp, v, out):
+    """π_c(v) of the model (tables + analytic tail) at reduced separations v."""
+    for i in range(v.size):
+        out[i] = math.exp(_state(tab, mp, v[i])[0])
+
+
+@njit(cache=True)
+def lnv_of_lnp_kernel(tab, mp, xs, out):
+    """ln v consistent with the model's π_c(v) at ln π = xs."""
+    for i in range(xs.size):
+        out[i] = _lnv_of_lnp(tab, mp, xs[i])
+
+
+@njit(cache=True)
+def sigma_kernel(tab, xs, out):
+    """σ̄ of the tables at ln π = xs."""
+    for i in range(xs.size):
+        out[i] = k_sigma_of_lnp(tab, xs[i])
+
+
+@njit(cache=True)
+def lnu_kernel(tab, xs, out):
+    """ln(ū/h_rms) of the tables at ln π = xs."""
+    for i in range(xs.size):
+        out[i] = k_lnu_of_lnp(tab, xs[i])

@@ -1,0 +1,198 @@
+"""The squeeze-out model of one (tables, theory): analytic tail above the table, trap
+criterion, default start, and the cached time primitive.
+
+Lorenz & Persson, Eur. Phys. J. E 32, 281 (2010), eqs. (3), (17)–(19), (23);
+doi:10.1140/epje/i2010-10626-9.
+"""
+from __future__ import annotations
+
+import hashlib
+import math
+import threading
+import time as _clock
+import weakref
+from collections import namedtuple
+
+import numpy as np
+
+from ..tables import Tables
+from . import _kernels as qk
+from . import primitive as prim
+
+__all__ = ["ModelPar", "SqueezeModel", "squeeze_model", "DEFAULT_P_START", "TAIL_EXTENT"]
+
+#: default start: p_cont(u_start) = DEFAULT_P_START * p0 (the fluid carries 99.9 % of the load)
+DEFAULT_P_START = 1e-3
+#: extent of the analytic tail above the table top, in units of u0 (π drops by e^-40)
+TAIL_EXTENT = 40.0
+
+#: scalar model parameters (reduced units) passed to the kernels:
+#: x_min, x_max  ln p̄ range of the tables; v_top, u0  ū/h_rms at the table top and the decay
+#: length of eq. (3) there; c, d  the tail σ̄ = y³ - c y, y = v + d; x_trap  ln π where σ̄
+#: falls to sigma_trap (inf: never); v_ext  start of the closed-form tail; x_perc  ln of the
+#: exact percolation pressure; v_trap  separation at x_trap; lnp_start  ln DEFAULT_P_START
+ModelPar = namedtuple("ModelPar", "x_min x_max v_top u0 c x_trap v_ext x_perc v_trap "
+                                  "lnp_start d")
+
+
+def _ev(kernel, *args):
+    xs = np.ascontiguousarray(args[-1], dtype=np.float64)
+    out = np.empty(xs.size)
+    kernel(*args[:-1], xs, out)
+    return out
+
+
+def _tail_fit(tab, x_min):
+    """(v_top, u0, c, d): the table top and the analytic tail matched to it in value and
+    slope (σ̄ = y³ - c y, y = v + d; leading order σ̄ = v³ is exact above the roughness)."""
+    ev_u = _ev(qk.lnu_kernel, tab, np.array([x_min, x_min + 1e-4]))
+    v_top = math.exp(ev_u[0])
+    u0 = -(math.exp(ev_u[1]) - v_top) / 1e-4          # -dv/dln p at the top
+    hx = 1e-4
+    sg = _ev(qk.sigma_kernel, tab, np.array([x_min, x_min + hx, x_min + 2 * hx]))
+    sig_top = float(sg[0])
+    dlns_dx = (-3.0 * math.log(sg[0]) + 4.0 * math.log(sg[1]) - math.log(sg[2])) / (2 * hx)
+    s1 = sig_top * dlns_dx / (-u0)                    # dσ̄/dv at the top
+    y = v_top
+    for _ in range(100):                              # 2y³ - s1 y + σ̄ = 0 near v_top
+        f = 2 * y ** 3 - s1 * y + sig_top
+        dy = f / (6 * y * y - s1)
+        y -= dy
+        if abs(dy) < 1e-15 * y:
+            break
+    d = y - v_top
+    c = 3 * y * y - s1
+    if not (abs(d) < 0.1 * v_top and abs(c) < 0.1 * y * y):   # fall back: value only
+        d, c = 0.0, v_top ** 2 - sig_top / v_top
+    return v_top, u0, c, d
+
+
+class SqueezeModel:
+    """The per-(tables, theory) model: kernel records, tail, trap and the time primitive.
+
+    Attributes
+    ----------
+    tab : tuple
+        The tables' kernel record of ``theory``.
+    mp : ModelPar
+        Scalar model parameters (reduced units).
+    h_rms : float
+        Rms roughness [m].
+    """
+
+    def __init__(self, tables, theory, sigma_trap=None):
+        t_start = _clock.perf_counter()
+        self.tables = weakref.proxy(tables)
+        self.theory = theory
+        self.h_rms = float(tables.h_rms)
+        tab = tables.kernel_data(theory)
+        self.tab = tab
+        p_lo, p_hi = tables.p_range
+        x_min, x_max = math.log(p_lo), math.log(p_hi)
+        self.sigma_trap = float(tables.info.get("sigma_floor", 1e-24) if sigma_trap is None
+                                else sigma_trap)
+        v_top, u0, c, d = _tail_fit(tab, x_min)
+        perc = tables.info["percolation_p_over_E"][theory]
+        x_perc = math.log(perc) if np.isfinite(perc) else math.inf
+        x_trap = self._find_trap(tab, x_min, x_max, x_perc)
+        mp = ModelPar(x_min, x_max, v_top, u0, c, x_trap, v_top + TAIL_EXTENT * u0, x_perc,
+                      math.nan, math.log(DEFAULT_P_START), d)
+        if np.isfinite(x_trap):
+            v_trap = math.exp(_ev(qk.lnv_of_lnp_kernel, tab, mp, np.array([x_trap]))[0])
+            mp = mp._replace(v_trap=v_trap)
+        self.mp = mp
+        self.x_min, self.x_max, self.x_trap, self.x_perc = x_min, x_max, x_trap, x_perc
+        self.v_top, self.u0, self.c_tail, self.d_tail = v_top, u0, c, d
+        self._prim = None
+        self._lock = threading.Lock()
+        self.setup_seconds = _clock.perf_counter() - t_start
+
+    def _find_trap(self, tab, x_min, x_max, x_perc):
+        """ln π where σ̄ falls to sigma_trap (bisection on the tables' σ̄); inf if never."""
+        if not np.isfinite(x_perc):
+            return math.inf  # "average": σ̄ = v³ exactly, no percolation, nothing to floor
+        hi = min(x_perc, x_max)
+        if float(_ev(qk.sigma_kernel, tab, np.array([hi]))[0]) >= self.sigma_trap:
+            return math.inf if x_perc > x_max else x_perc
+        lo = x_min
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            if float(_ev(qk.sigma_kernel, tab, np.array([mid]))[0]) >= self.sigma_trap:
+                lo = mid
+            else:
+                hi = mid
+            if hi - lo < 1e-15:
+                break
+        return hi
+
+    def primitive(self, cache_dir=None):
+        """The time primitive of this model (built on first use, or read from ``cache_dir``)."""
+        with self._lock:
+            if self._prim is None:
+                self._prim = prim.load_or_build(self, cache_dir)
+            return self._prim
+
+    def p_of_v(self, v):
+        """π_c(v) of the model (tables + analytic tail) at reduced separations v [-]."""
+        return _ev(qk.p_of_v_kernel, self.tab, self.mp, v)
+
+    def key(self):
+        """Content key of this model (tables content, theory, trap floor, primitive version)."""
+        t = self.tables
+        raw = repr((t.surface.fingerprint(), tuple(t.theories), t.p_range,
+                    int(t.info.get("nodes", -1)), sorted(t.options.items()), self.theory,
+                    self.sigma_trap, prim.PRIMITIVE_VERSION, _digest(t)))
+        return hashlib.sha256(raw.encode()).hexdigest()[:32]
+
+
+def _digest(tables):
+    h = getattr(tables, "_squeeze_digest", None)
+    if h is None:
+        d = hashlib.sha256()
+        for k in sorted(tables.data):
+            d.update(k.encode())
+            d.update(np.ascontiguousarray(tables.data[k]).tobytes())
+        h = d.hexdigest()
+        try:
+            tables._squeeze_digest = h
+        except AttributeError:
+            pass
+    return h
+
+
+_MODELS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_MODELS_LOCK = threading.Lock()
+
+
+def _fingerprint(tables):
+    return (tables.surface.fingerprint(), tuple(tables.theories), tables.p_range,
+            int(tables.info.get("nodes", -1)), repr(sorted(tables.options.items())))
+
+
+def squeeze_model(tables, theory="average", sigma_trap=None) -> SqueezeModel:
+    """The cached :class:`SqueezeModel` of (tables, theory), built on first use.
+
+    Parameters
+    ----------
+    tables : Tables
+        Precomputed surface tables holding ``theory``.
+    theory : str
+        Flow-conductivity theory.
+    sigma_trap : float or None
+        Reduced conductivity floor of the trap criterion [-] (default: the tables'
+        ``info["sigma_floor"]``).
+    """
+    if not isinstance(tables, Tables):
+        raise ValueError(f"tables = {tables!r} is invalid: must be a fastcontact Tables "
+                         f"(fastcontact.precompute(...) or Tables.from_parquet(...))")
+    tables._need(theory)
+    fp = _fingerprint(tables)
+    with _MODELS_LOCK:
+        entry = _MODELS.get(tables)
+        if entry is None or entry["fp"] != fp:
+            entry = {"fp": fp}
+            _MODELS[tables] = entry
+        key = (theory, sigma_trap)
+        if key not in entry:
+            entry[key] = SqueezeModel(tables, theory, sigma_trap)
+        return entry[key]
