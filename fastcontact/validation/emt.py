@@ -104,6 +104,36 @@ def _solve(W, sig, A1, k):
     return math.exp(brentq(f, lo, hi, xtol=1e-14, rtol=1e-13))
 
 
+_CACHE = {}
+_CACHE_MAX = 2048
+
+
+def _weights_sigma(psd, fp, pb, A1, gamma, n_panels):
+    """Node weights W_j and reduced σ_j = (u1/h_rms)³ (inf = masked) at one pressure.
+
+    They do not depend on the threshold, so a fit that varies only the threshold reuses them
+    (cached per PSD fingerprint, p̄, γ and panel count)."""
+    from .. import contact
+
+    key = (fp, pb, gamma, n_panels)
+    hit = _CACHE.get(key)
+    if hit is not None:
+        return hit
+    s_nodes, w_nodes = _nodes(n_panels)
+    area = A1 + (1.0 - A1) * s_nodes
+    W = (1.0 - A1) * w_nodes
+    inside = (area > A1) & (area < 1.0)
+    zeta = np.ones_like(area)
+    zeta[inside] = np.clip(_zeta_at_area(psd, pb, area[inside]), 1.0, psd.zeta1)
+    u1 = contact.u1(psd, pb, 1.0, zeta, gamma=gamma)
+    sig = np.where(np.ma.getmaskarray(u1) | ~inside, np.inf,
+                   (np.maximum(np.ma.getdata(u1), 0.0) / psd.h_rms) ** 3)
+    if len(_CACHE) >= _CACHE_MAX:
+        _CACHE.clear()
+    _CACHE[key] = (W, sig)
+    return W, sig
+
+
 def emt_sigma_bar(psd, pbar, *, threshold=0.5, gamma=1.0):
     """Reduced conductivity σ̄ = 12ησ_eff/h_rms³ of the generalized medium (E2) [-].
 
@@ -118,7 +148,6 @@ def emt_sigma_bar(psd, pbar, *, threshold=0.5, gamma=1.0):
     gamma : float
         Yang–Persson factor of u1(ζ) (1 = the paper's A4).
     """
-    from .. import contact
     from scipy.special import erf
 
     k = threshold_k(threshold)
@@ -126,6 +155,7 @@ def emt_sigma_bar(psd, pbar, *, threshold=0.5, gamma=1.0):
     if np.any(~np.isfinite(pbar)) or np.any(pbar <= 0):
         raise ValueError(f"pbar = {pbar!r} is invalid: must be finite and > 0 [-]")
     m3_1 = float(np.asarray(psd.moment(3.0, psd.q0, psd.q1)))
+    fp = psd.fingerprint() if hasattr(psd, "fingerprint") else repr(psd)
     out = np.empty(pbar.size)
     for i, pb in enumerate(pbar):
         A1 = float(erf(pb / (2.0 * math.sqrt(0.25 * math.pi * m3_1))))
@@ -135,15 +165,7 @@ def emt_sigma_bar(psd, pbar, *, threshold=0.5, gamma=1.0):
         prev = None
         n_panels = N_PANELS
         while True:
-            s_nodes, w_nodes = _nodes(n_panels)
-            area = A1 + (1.0 - A1) * s_nodes
-            W = (1.0 - A1) * w_nodes
-            inside = (area > A1) & (area < 1.0)
-            zeta = np.ones_like(area)
-            zeta[inside] = np.clip(_zeta_at_area(psd, pb, area[inside]), 1.0, psd.zeta1)
-            u1 = contact.u1(psd, pb, 1.0, zeta, gamma=gamma)
-            sig = np.where(np.ma.getmaskarray(u1) | ~inside, np.inf,
-                           (np.maximum(np.ma.getdata(u1), 0.0) / psd.h_rms) ** 3)
+            W, sig = _weights_sigma(psd, fp, float(pb), A1, float(gamma), n_panels)
             val = _solve(W, sig, A1, k)
             if prev is not None and (abs(val - prev) <= TOL * abs(val)
                                      or n_panels >= MAX_PANELS):
