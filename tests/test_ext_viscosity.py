@@ -1,0 +1,153 @@
+"""Issue 14.2: pressure-dependent (Barus) viscosity in squeeze-out and seals.
+
+References: ``tests/reference/ext_reynolds.py`` integrates the Reynolds equation with η(p)
+directly (scipy solve_ivp / solve_bvp / brentq / quad), without the reduced-pressure ψ
+reduction the package uses; α = 0 must reproduce the base engines exactly.
+"""
+from __future__ import annotations
+
+import math
+import os
+import sys
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reference.ext_reynolds import (barus, hertz_shoot, radial_mean_pressure,  # noqa: E402
+                                    seal_bvp, squeeze_time)
+
+import fastcontact as fc  # noqa: E402
+from fastcontact.seal import seal_leak  # noqa: E402
+from fastcontact.seal.viscosity import seal_leak_piezo  # noqa: E402
+from fastcontact.squeeze import squeeze_out  # noqa: E402
+from fastcontact.squeeze.viscosity import (barus_mean_pressure, barus_rate_factor,  # noqa: E402
+                                           squeeze_out_piezo)
+
+E_STAR = 1e7
+ETA = 1e-3
+L_Y = 0.1
+
+
+@pytest.fixture(scope="module")
+def tables():
+    psd = fc.SelfAffinePSD(h_rms=5e-6, hurst=0.8, q0=1e4, q1=1e8)
+    return fc.precompute(psd, theories=("average", "critical_junction", "emt"))
+
+
+def _sigma(tables, theory):
+    plo = tables.p_range[0] * E_STAR
+    return lambda pc: tables.conductivity(np.maximum(pc, plo * (1 + 1e-7)), E_STAR, ETA, theory)
+
+
+# --------------------------------------------------------------------------- closed forms
+@pytest.mark.parametrize("alpha,K", [(1e-9, 1e4), (1e-9, 1e6), (1e-8, 3e7), (1e-8, 1.9e8),
+                                     (3e-8, 6.6e7), (3e-8, 1e3)])
+def test_mean_pressure_matches_radial_reynolds(alpha, K):
+    ref = radial_mean_pressure(K, barus(alpha))
+    assert abs(barus_mean_pressure(K / 2, alpha) / ref - 1) < 1e-9
+
+
+def test_mean_pressure_limits():
+    assert barus_mean_pressure(2e5, 0.0) == 1e5
+    # α → 0 continuously (series branch vs the exact branch)
+    assert abs(barus_mean_pressure(2e5, 1e-12) / 1e5 - 1) < 1e-6
+    # b → 1: p̄_f → 1/α; beyond: NaN (no solution)
+    assert abs(barus_mean_pressure(1e8 * (1 - 1e-12), 1e-8) * 1e-8 - 1) < 1e-9
+    assert np.isnan(barus_mean_pressure(1.01e8, 1e-8))
+
+
+def test_rate_factor_limits_and_monotone():
+    a = np.linspace(0, 0.999999, 2001)
+    g = barus_rate_factor(a)
+    assert g[0] == 1.0
+    assert np.all(np.diff(g) < 0)
+    assert abs(g[-1] - 0.5) < 1e-3
+    # g(a) = Φ⁻¹(a)/(2a) with the closed-form Φ: check by composition
+    b = 2 * a[1:] * g[1:]
+    phi = 1 + (1 - b) * np.log1p(-b) / b
+    assert np.max(np.abs(phi - a[1:])) < 1e-12
+    small = np.array([1e-7, 9.9e-6, 1.01e-5])     # series branch and its neighbour agree
+    assert np.allclose(barus_rate_factor(small), 1 - 2 * small / 3 + 2 * small ** 2 / 9,
+                       rtol=1e-13)
+    assert np.isnan(barus_rate_factor(1.0))
+
+
+# --------------------------------------------------------------------------- squeeze-out
+@pytest.mark.parametrize("theory", ["average", "emt"])
+def test_squeeze_alpha_zero_is_base(tables, theory):
+    kw = dict(p0=np.array([2e4, 1e5, 4e5]), E_star=E_STAR, R=0.01, eta=ETA, theory=theory,
+              ratios=(1.1, 1.001))
+    a = squeeze_out(tables, method="quad", **kw)
+    b = squeeze_out_piezo(tables, alpha_pv=0.0, **kw)
+    for c in ("u_start", "u_inf", "t_star", "t_ratio_1.1", "t_ratio_1.001"):
+        np.testing.assert_allclose(b[c], a[c], rtol=1e-12)
+
+
+@pytest.mark.parametrize("p0,alpha", [(1e5, 3e-6), (4e5, 2e-6)])
+def test_squeeze_against_reynolds_reference(tables, p0, alpha):
+    df = squeeze_out_piezo(tables, p0=p0, E_star=E_STAR, R=0.01, eta=ETA, alpha_pv=alpha,
+                           theory="emt", ratios=(1.1,))
+    r = df.iloc[0]
+    assert 0.5 < r.rate_factor_start < 0.9          # the viscosity really is pressure dependent
+    ref = squeeze_time(tables, "emt", p0, E_STAR, 0.01, ETA, alpha, r.u_start, 1.1 * r.u_inf,
+                       r.u_inf)
+    assert abs(r["t_ratio_1.1"] / ref - 1) < 1e-7
+    base = squeeze_out_piezo(tables, p0=p0, E_star=E_STAR, R=0.01, eta=ETA, alpha_pv=0.0,
+                             theory="emt", ratios=(1.1,))
+    assert 1.0 < r["t_ratio_1.1"] / base["t_ratio_1.1"][0] < 2.0     # g ∈ (1/2, 1]
+
+
+def test_squeeze_piezo_limit_flagged(tables):
+    df = squeeze_out_piezo(tables, p0=4e5, E_star=E_STAR, R=0.01, eta=ETA,
+                           alpha_pv=[1e-6, 3e-6], theory="average")
+    assert list(df.piezo_limit) == [False, True]
+    assert np.isnan(df.t_star[1]) and np.isfinite(df.t_star[0])
+
+
+def test_squeeze_bad_alpha(tables):
+    with pytest.raises(ValueError, match="alpha_pv"):
+        squeeze_out_piezo(tables, p0=1e5, E_star=E_STAR, R=0.01, eta=ETA, alpha_pv=-1e-8)
+
+
+# --------------------------------------------------------------------------- seals
+@pytest.mark.parametrize("theory", ["critical_junction", "emt"])
+def test_seal_uniform(tables, theory):
+    p0, L = 5e4, 5e-3
+    dp = np.array([1e3, 2e4, 4.5e4])
+    base = seal_leak(tables, p0=p0, dp=dp, L=L, L_y=L_Y, E_star=E_STAR, eta=ETA, theory=theory)
+    zero = seal_leak_piezo(tables, p0=p0, dp=dp, L=L, L_y=L_Y, E_star=E_STAR, eta=ETA,
+                           alpha_pv=0.0, theory=theory)
+    np.testing.assert_allclose(zero.Q, base.Q, rtol=1e-9)
+    for d, al in [(2e4, 3e-5), (4.5e4, 3e-5)]:
+        q, _ = seal_bvp(_sigma(tables, theory), lambda x: p0 + 0 * x, 0.0, L, d, 0.0, al)
+        got = seal_leak_piezo(tables, p0=p0, dp=d, L=L, L_y=L_Y, E_star=E_STAR, eta=ETA,
+                              alpha_pv=al, theory=theory).Q[0]
+        assert abs(got / (q * L_Y) - 1) < 1e-8
+
+
+@pytest.mark.parametrize("theory", ["critical_junction", "emt"])
+def test_seal_hertz(tables, theory):
+    R, f_N = 1e-3, 3.0
+    a = math.sqrt(4 * f_N * R / (math.pi * E_STAR))
+    pH = 2 * f_N / (math.pi * a)
+    base = seal_leak(tables, profile="hertz", R=R, f_N=f_N, dp=3e4, L_y=L_Y, E_star=E_STAR,
+                     eta=ETA, theory=theory)
+    zero = seal_leak_piezo(tables, profile="hertz", R=R, f_N=f_N, dp=3e4, L_y=L_Y,
+                           E_star=E_STAR, eta=ETA, alpha_pv=0.0, theory=theory)
+    assert abs(zero.Q[0] / base.Q[0] - 1) < 3e-8
+    dp, al = 6e4, 3e-5
+    ref = hertz_shoot(_sigma(tables, theory), pH, a, dp, 0.0, al) * L_Y
+    got = seal_leak_piezo(tables, profile="hertz", R=R, f_N=f_N, dp=dp, L_y=L_Y,
+                          E_star=E_STAR, eta=ETA, alpha_pv=al, theory=theory)
+    assert bool(got.converged[0])
+    assert abs(got.Q[0] / ref - 1) < 3e-8
+
+
+def test_seal_flags(tables):
+    df = seal_leak_piezo(tables, p0=5e4, dp=[0.0, 6e4], L=5e-3, L_y=L_Y, E_star=E_STAR,
+                         eta=ETA, alpha_pv=1e-5)
+    assert df.Q[0] == 0.0 and df.Q[1] == math.inf and bool(df.lift_off[1])
+    with pytest.raises(ValueError, match="alpha_pv"):
+        seal_leak_piezo(tables, p0=5e4, dp=1e3, L=5e-3, L_y=L_Y, E_star=E_STAR, eta=ETA,
+                        alpha_pv=float("nan"))
