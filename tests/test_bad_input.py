@@ -144,3 +144,95 @@ def test_contact_pressure_bad_separation(bad):
 @pytest.mark.parametrize("bad", [-1e7, 0.0, NAN])
 def test_contact_pressure_bad_E_star(bad):
     _raises_naming("E_star", lambda: contact.contact_pressure(_psd(), 1e-5, bad))
+
+
+# ------------------------------------------------- issue 15.3: types refused by name
+import datetime as _dt  # noqa: E402
+
+import pandas as pd  # noqa: E402
+
+from fastcontact._core.validate import align_inputs, check_positive  # noqa: E402
+
+_BAD_TYPES = [
+    True, False, np.bool_(True), np.array([True, False]), [1e5, True],
+    np.datetime64("2024-01-01"), np.timedelta64(3, "s"), _dt.datetime(2024, 1, 1),
+    _dt.timedelta(seconds=1), 1 + 2j, np.complex128(1.0), np.array([1.0 + 0j]),
+    "1e5", np.array(["1e5"]), b"1e5", None, object(), {"p": 1e5}, [1e5, [2e5, 3e5]],
+    pd.Series([1e5, pd.NA], dtype="Float64"),
+]
+_IDS = ["True", "False", "np.bool_", "bool-array", "list-with-True", "datetime64",
+        "timedelta64", "datetime", "timedelta", "complex", "complex128", "complex-array",
+        "str", "str-array", "bytes", "None", "object", "dict", "ragged", "pd.NA"]
+
+
+def _one_line_naming(name, fn):
+    with pytest.raises(ValueError) as exc:
+        fn()
+    msg = str(exc.value)
+    assert msg.startswith(f"{name} = "), msg
+    assert "\n" not in msg and "is invalid" in msg, msg
+
+
+@pytest.mark.parametrize("bad", _BAD_TYPES, ids=_IDS)
+def test_bad_types_refused_in_contact(bad):
+    _one_line_naming("p", lambda: contact.mean_separation(_psd(), bad, E_STAR))
+    _one_line_naming("E_star", lambda: contact.mean_separation(_psd(), 1e5, bad))
+
+
+@pytest.mark.parametrize("bad", _BAD_TYPES, ids=_IDS)
+def test_bad_types_refused_in_psd(bad):
+    _one_line_naming("h_rms", lambda: fastcontact.SelfAffinePSD(**dict(GOOD_PSD, h_rms=bad)))
+
+
+def test_bool_message_says_why():
+    with pytest.raises(ValueError, match=r"^E_star = True is invalid: it is a boolean"):
+        contact.mean_separation(_psd(), 1e5, True)
+
+
+def test_masked_arrays_honoured():
+    p = np.ma.masked_array([1e4, 2e4, 3e4], mask=[False, True, False])
+    with pytest.raises(ValueError, match=r"^p = .*1 masked value\(s\) \(first at index \(1,\)\)"):
+        contact.mean_separation(_psd(), p, E_STAR)
+    clean = np.ma.masked_array([1e4, 3e4], mask=[False, False])
+    np.testing.assert_array_equal(contact.mean_separation(_psd(), clean, E_STAR),
+                                  contact.mean_separation(_psd(), np.array([1e4, 3e4]), E_STAR))
+    with pytest.raises(ValueError, match="masked"):
+        fastcontact.TabulatedPSD(np.ma.masked_array(_Q, mask=_Q > 1e7), _C)
+
+
+def test_tabulated_psd_refuses_2d():
+    with pytest.raises(ValueError, match=r"^q has shape \(2, 4\).*never flattened"):
+        fastcontact.TabulatedPSD(_Q.reshape(2, 4), _C.reshape(2, 4))
+    with pytest.raises(ValueError, match=r"^C has shape \(8, 1\)"):
+        fastcontact.TabulatedPSD(_Q, _C.reshape(8, 1))
+
+
+def test_nan_refused_where_invalid():
+    _one_line_naming("p", lambda: contact.mean_separation(_psd(), np.array([1e4, NAN]), E_STAR))
+    _one_line_naming("C", lambda: fastcontact.TabulatedPSD(_Q, np.where(_Q > 1e6, NAN, _C)))
+
+
+def test_pandas_series_accepted_and_aligned_by_label():
+    s = pd.Series([1e4, 2e4], index=["a", "b"])
+    np.testing.assert_array_equal(contact.mean_separation(_psd(), s, E_STAR),
+                                  contact.mean_separation(_psd(), np.array([1e4, 2e4]), E_STAR))
+    p0 = pd.Series([1.0, 2.0, 3.0], index=["x", "y", "z"])
+    eta = pd.Series([30.0, 10.0, 20.0], index=["z", "x", "y"])
+    out = align_inputs(p0=p0, eta=eta, R=0.01)
+    assert out["eta"].tolist() == [10.0, 20.0, 30.0] and out["R"] == 0.01
+    with pytest.raises(ValueError, match=r"^p0 and eta are pandas Series whose index labels "
+                                         r"disagree \(only in p0: \['z'\]; only in eta: \['w'\]\)"):
+        align_inputs(p0=p0, eta=pd.Series([1.0, 2.0, 3.0], index=["x", "y", "w"]))
+    with pytest.raises(ValueError, match="duplicated labels"):
+        align_inputs(p0=p0, eta=pd.Series([1.0, 2.0, 3.0], index=["x", "x", "y"]))
+
+
+def test_every_message_is_one_line():
+    h = np.random.default_rng(0).standard_normal((16, 16)) * 1e-6
+    for fn in (lambda: check_positive("x", "abc", "[m]"),
+               lambda: fastcontact.psd_from_heights(h, True),
+               lambda: fastcontact.psd_from_heights(h, 1e-6, n_bins=True),
+               lambda: fastcontact.psd_from_heights(np.ma.masked_invalid(h * np.nan), 1e-6)):
+        with pytest.raises(ValueError) as exc:
+            fn()
+        assert "\n" not in str(exc.value)

@@ -102,7 +102,7 @@ def _unit_attr(value):
             u = getattr(value, attr, None)
         except Exception:  # noqa: BLE001 - a property that raises: not a quantity
             u = None
-        if u is not None and not isinstance(u, str) and hasattr(value, "to"):
+        if u is not None and hasattr(value, "to"):
             return u
     return None
 

@@ -173,18 +173,33 @@ def _hann(n):
 
 
 def _windowed(h, w):
-    """``h·w`` scaled so that its variance without the q = 0 term (which the spectrum drops)
-    equals mean(h²) of the detrended ``h``: the windowed spectrum keeps h_rms exactly.
+    """``h·w`` with the window scaled to mean(w²) = 1 (unbiased C where the spectrum varies
+    slowly over the window's main lobe, i.e. everywhere but the lowest few wavevectors)."""
+    return h * w
 
-    ``h`` is a map (``w`` the separable 2-D window) or rows of scans (``w`` 1-D, one scale
-    for all rows, so their relative weights are kept)."""
-    hw = h * w
-    if h.ndim == 2 and w.ndim == 1:
-        var = np.mean(np.mean(hw * hw, axis=-1) - np.mean(hw, axis=-1) ** 2)
-    else:
-        var = np.mean(hw * hw) - np.mean(hw) ** 2
-    h2 = np.mean(h * h)
-    return hw * math.sqrt(h2 / var) if var > 0 else hw
+
+#: the lowest bins — below this many lattice cells 2π/L — absorb the variance a window loses
+WINDOW_LOW_CELLS = 4.0
+
+
+def _keep_variance(edges, mean, dim, target, q_c):
+    """Bin means rescaled so that the binned energy equals ``target`` (mean(h²) of the
+    detrended heights less what lies beyond the band): the deficit (or excess) of the
+    windowed data is put into the bins below ``q_c`` — where the window's main lobe, a few
+    lattice cells wide, smears and loses the long-wavelength energy (trend, DC) anyway — so
+    the spectrum above keeps its unbiased level and h_rms is preserved. If those bins cannot
+    absorb it, every bin is scaled."""
+    meas = (math.pi * (edges[1:] ** 2 - edges[:-1] ** 2) if dim == 2
+            else 2.0 * (edges[1:] - edges[:-1]))
+    energy = mean * meas
+    low = edges[1:] <= q_c * (1 + 1e-9)
+    if not low.any():
+        low[0] = True
+    rest = float(energy[~low].sum())
+    e_low = float(energy[low].sum())
+    if e_low > 0 and target - rest > 0:
+        return np.where(low, mean * (target - rest) / e_low, mean)
+    return mean * (target / float(energy.sum()))
 
 
 # ============================================================================ 1-D spectra
@@ -227,6 +242,8 @@ def _spectrum_1d(rows, spacing, n_bins, window, detrend):
         raise ValueError("heights = constant (after detrending) is invalid: the surface must "
                          "have roughness (nonzero spectrum)")
     edges, mean, cnt = _trim_roundoff(edges, mean, cnt)
+    if window is not None:
+        mean = _keep_variance(edges, mean, 1, h2, WINDOW_LOW_CELLS * dq)
     q, d = _histopolate(edges, mean, dim=1)
     cnt = np.concatenate((cnt[:1], cnt, cnt[-1:]))
     w = cnt * np.minimum(rows.shape[0], np.maximum(1.0, q / q_lo))
@@ -302,6 +319,13 @@ def _map_psd(h, spacing, n_bins, window, detrend):
                          f"the Nyquist wavevector {q_hi:.4g} [1/m] (all of it is in the FFT "
                          f"corners)")
     edges, mean, _ = _trim_roundoff(edges, mean, np.zeros(mean.size))
+    if window is not None:
+        # the windowed periodogram's share beyond the band (FFT corners) stays outside; its
+        # q = 0 term (the windowed data's mean) is not roughness
+        total = float(Ck.sum() - Ck[0, 0]) * dqx * dqy
+        inband = float(Ck.ravel()[(qk >= edges[0]) & (qk <= edges[-1])].sum()) * dqx * dqy
+        mean = _keep_variance(edges, mean, 2, h2 * inband / total,
+                              WINDOW_LOW_CELLS * 2.0 * math.pi / max(nx * ax, ny * ay))
     q, C = _histopolate(edges, mean, dim=2)
     return TabulatedPSD(q, C, convention="persson"), h2
 
