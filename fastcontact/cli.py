@@ -35,11 +35,20 @@ class CLIError(ValueError):
     """Bad command-line input."""
 
 
+class _Help(argparse.ArgumentDefaultsHelpFormatter):
+    """Shows an option's default where it has one (not for flags and open options)."""
+
+    def _get_help_string(self, action):
+        if action.default in (None, False) or action.default is argparse.SUPPRESS:
+            return action.help
+        return super()._get_help_string(action)
+
+
 class _Parser(argparse.ArgumentParser):
     """One-line errors (exit 2) and every option's default shown in its help."""
 
     def __init__(self, *args, **kw):
-        kw.setdefault("formatter_class", argparse.ArgumentDefaultsHelpFormatter)
+        kw.setdefault("formatter_class", _Help)
         super().__init__(*args, **kw)
 
     def error(self, message):  # one line, exit 2
@@ -66,6 +75,34 @@ def _count(text):
     if not (x >= 1 and x == int(x)):
         raise argparse.ArgumentTypeError(f"{text!r} must be a whole number >= 1")
     return int(x)
+
+
+def _add_tables_parser(sub):
+    """The ``tables`` command and its subcommands."""
+    t = sub.add_parser("tables", help="build or inspect contact/flow tables")
+    tsub = t.add_subparsers(dest="tables_command", metavar="SUBCOMMAND", parser_class=_Parser)
+    tb = tsub.add_parser("build", help="tabulate one surface")
+    tb.add_argument("--h-rms", type=_quantity("length"), help="rms roughness (m, or e.g. '0.72 mm')")
+    tb.add_argument("--hurst", type=float, help="Hurst exponent H")
+    tb.add_argument("--q0", type=_quantity("wavevector"), help="smallest wavevector [1/m]")
+    tb.add_argument("--q1", type=_quantity("wavevector"), help="largest wavevector [1/m]")
+    tb.add_argument("--q-roll", type=_quantity("wavevector"), help="roll-off wavevector [1/m]")
+    tb.add_argument("--psd", help="PSD file (.csv or .parquet with columns q, C)")
+    tb.add_argument("--convention", choices=("persson", "surface_topography"),
+                    help="normalisation of the PSD file's C")
+    tb.add_argument("--theories", nargs="+", default=["average", "critical_junction", "emt"],
+                    help="flow theories to tabulate (space or comma separated)")
+    tb.add_argument("--gamma", type=float, default=1.0, help="Yang-Persson factor (1 = paper)")
+    tb.add_argument("--a-perc", type=float, default=0.5, help="percolation threshold A/A0")
+    tb.add_argument("--alpha-cj", type=float, default=1.0, help="critical-junction factor")
+    tb.add_argument("-o", "--output", required=True, help="output .parquet file")
+    ti = tsub.add_parser("info", help="show a table file's metadata")
+    ti.add_argument("file", help="tables .parquet file")
+    ti.add_argument("--json", action="store_true", help="print the raw metadata as JSON")
+    td = tsub.add_parser("defaults", help="rebuild the embedded default tables")
+    td.add_argument("-o", "--output-dir", action="append",
+                    help="folder to write to (repeatable; default: ./tables of a source "
+                         "checkout; never the installed package)")
 
 
 def build_parser():
@@ -96,30 +133,7 @@ def build_parser():
     s = sub.add_parser("scenes", help="list the shipped example scenes, or print one")
     s.add_argument("name", nargs="?", help="example scene to print")
 
-    t = sub.add_parser("tables", help="build or inspect contact/flow tables")
-    tsub = t.add_subparsers(dest="tables_command", metavar="SUBCOMMAND", parser_class=_Parser)
-    tb = tsub.add_parser("build", help="tabulate one surface")
-    tb.add_argument("--h-rms", type=_quantity("length"), help="rms roughness (m, or e.g. '0.72 mm')")
-    tb.add_argument("--hurst", type=float, help="Hurst exponent H")
-    tb.add_argument("--q0", type=_quantity("wavevector"), help="smallest wavevector [1/m]")
-    tb.add_argument("--q1", type=_quantity("wavevector"), help="largest wavevector [1/m]")
-    tb.add_argument("--q-roll", type=_quantity("wavevector"), help="roll-off wavevector [1/m]")
-    tb.add_argument("--psd", help="PSD file (.csv or .parquet with columns q, C)")
-    tb.add_argument("--convention", choices=("persson", "surface_topography"),
-                    help="normalisation of the PSD file's C")
-    tb.add_argument("--theories", nargs="+", default=["average", "critical_junction", "emt"],
-                    help="flow theories to tabulate (space or comma separated)")
-    tb.add_argument("--gamma", type=float, default=1.0, help="Yang-Persson factor (1 = paper)")
-    tb.add_argument("--a-perc", type=float, default=0.5, help="percolation threshold A/A0")
-    tb.add_argument("--alpha-cj", type=float, default=1.0, help="critical-junction factor")
-    tb.add_argument("-o", "--output", required=True, help="output .parquet file")
-    ti = tsub.add_parser("info", help="show a table file's metadata")
-    ti.add_argument("file", help="tables .parquet file")
-    ti.add_argument("--json", action="store_true", help="print the raw metadata as JSON")
-    td = tsub.add_parser("defaults", help="rebuild the embedded default tables")
-    td.add_argument("-o", "--output-dir", action="append",
-                    help="folder to write to (repeatable; default: ./tables of a source "
-                         "checkout; never the installed package)")
+    _add_tables_parser(sub)
 
     w = sub.add_parser("sweep", help="evaluate a scene on every surface of a road database (Dask)")
     w.add_argument("database", help="road database (Parquet dataset or folder of PSD files)")
@@ -429,9 +443,10 @@ def main(argv=None, out=None, err=None):
         prefix = "" if msg.startswith("fastcontact") else "fastcontact: error: "
         print(prefix + msg, file=err)
         return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
-        print("fastcontact: interrupted", file=err)
-        return 130
+    except KeyboardInterrupt as exc:
+        # a sweep's SweepInterrupted carries a one-line message and 130 (SIGINT) / 143 (SIGTERM)
+        print(f"fastcontact: {exc}" if str(exc) else "fastcontact: interrupted", file=err)
+        return getattr(exc, "exit_code", 130)
 
 
 def _entry():  # pragma: no cover

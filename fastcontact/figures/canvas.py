@@ -11,9 +11,12 @@ from .._core.io import atomic_path
 __all__ = ["new_figure", "save_png"]
 
 
-def new_figure(**kw):
-    """A pyplot-free Figure on the Agg canvas (no global backend switch, no figure manager)."""
-    fig = Figure(layout="constrained", **kw)
+def new_figure(layout="constrained", **kw):
+    """A pyplot-free Figure on the Agg canvas (no global backend switch, no figure manager).
+
+    ``layout=None`` skips the constrained layout (faster; place the axes with
+    ``fig.subplots_adjust``)."""
+    fig = Figure(layout=layout, **kw)
     FigureCanvasAgg(fig)
     return fig
 

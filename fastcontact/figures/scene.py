@@ -68,13 +68,20 @@ def _grid(fig, n):
 
 
 def _figure(n_panels):
+    """A figure sized for ``n_panels`` panels (fixed margins: no layout solver, fast)."""
     ncols = 1 if n_panels == 1 else min(3, n_panels)
     nrows = math.ceil(n_panels / ncols)
-    return new_figure(figsize=(6.4 if ncols == 1 else 4.6 * ncols, 4.8 if nrows == 1 else 3.8 * nrows))
+    w, h = (6.4 if ncols == 1 else 4.6 * ncols), (4.8 if nrows == 1 else 3.8 * nrows)
+    fig = new_figure(layout=None, figsize=(w, h))
+    fig.subplots_adjust(left=0.75 / w, right=1 - 0.55 / w, bottom=0.55 / h, top=1 - 0.5 / h,
+                        wspace=0.35, hspace=0.45)
+    return fig
 
 
-def _thin(items, limit=MAX_CURVES_PER_PANEL):
-    """``items`` evenly thinned to ``limit`` (first and last kept) and the original count."""
+def _thin(items, limit=None):
+    """``items`` evenly thinned to ``limit`` (default :data:`MAX_CURVES_PER_PANEL`; first and
+    last kept) and the original count."""
+    limit = MAX_CURVES_PER_PANEL if limit is None else limit
     if len(items) <= limit:
         return items, len(items)
     idx = np.unique(np.linspace(0, len(items) - 1, limit).round().astype(int))

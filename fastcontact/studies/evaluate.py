@@ -32,12 +32,12 @@ def _tidy(a, name=None):
         return a
 
 
-def _one_by_one(engine, tables, rows, idx, theory, fixed, columns, res, err):
+def _one_by_one(engine, tables, rows, idx, theory, fixed, columns, res, err, scale):
     """Evaluate the cases ``idx`` one at a time (a failed group): errors stay per row."""
     for k, i in enumerate(idx):
         row = rows.iloc[[k]].reset_index(drop=True)
         try:
-            out = engine(tables, row, theory, fixed, columns)
+            out = engine(tables, row, theory, fixed, columns, scale)
             for c in columns:
                 res[c][i] = np.ravel(out[c])[0]
             if "_error" in out:
@@ -46,7 +46,7 @@ def _one_by_one(engine, tables, rows, idx, theory, fixed, columns, res, err):
             err[i] = f"{type(exc).__name__}: {exc}"
 
 
-def evaluate_cases(kind, tables, cases, fixed, columns) -> pd.DataFrame:
+def evaluate_cases(kind, tables, cases, fixed, columns, scale=1.0) -> pd.DataFrame:
     """Evaluate every case (rows of ``cases``) of a ``kind`` study on one surface's ``tables``.
 
     Parameters
@@ -60,6 +60,9 @@ def evaluate_cases(kind, tables, cases, fixed, columns) -> pd.DataFrame:
         The study's non-axis parameters.
     columns : list of str
         Result columns wanted.
+    scale : float
+        Study size / ``len(cases)`` when ``cases`` is one block of a larger study (the engines
+        choose size-dependent methods from the study's size, not the block's).
 
     Returns
     -------
@@ -77,9 +80,9 @@ def evaluate_cases(kind, tables, cases, fixed, columns) -> pd.DataFrame:
     for theory, idx in cases.groupby("theory", sort=False).indices.items():
         rows = cases.iloc[idx].reset_index(drop=True)
         try:
-            out = engine(tables, rows, theory, fixed, columns)
+            out = engine(tables, rows, theory, fixed, columns, scale)
         except Exception:  # noqa: BLE001 - fall back to one case at a time (errors kept per row)
-            _one_by_one(engine, tables, rows, idx, theory, fixed, columns, res, err)
+            _one_by_one(engine, tables, rows, idx, theory, fixed, columns, res, err, scale)
             continue
         for c in columns:
             res[c][idx] = out[c]

@@ -57,8 +57,9 @@ class StudyKind:
     columns : callable
         ``columns(fixed) -> list[str]``: every result column the engine can produce.
     evaluate : callable
-        ``evaluate(tables, rows, theory, fixed, columns) -> dict`` of arrays (plus
-        ``"_error"``: one message per row, ``""`` where the row evaluated).
+        ``evaluate(tables, rows, theory, fixed, columns, scale=1.0) -> dict`` of arrays (plus
+        ``"_error"``: one message per row, ``""`` where the row evaluated); ``scale`` = study
+        size / block size, so that a method chosen by size is the same in every block.
     """
 
     name: str
@@ -123,7 +124,7 @@ def _squeeze_infer(axes, fixed, given, problems):
         problems.append("geometry.R is missing: the block radius, e.g. R = \"2 cm\"")
 
 
-def _squeeze_evaluate(tables, rows, theory, fixed, columns):
+def _squeeze_evaluate(tables, rows, theory, fixed, columns, scale=1.0):
     ratios = [r for r in fixed["ratios"] if column_name("t_ratio", r) in columns]
     du = [d for d in fixed["du"] if column_name("t_du", d) in columns]
     times = [t for t in fixed["times"] if column_name("u_at", t) in columns]
@@ -131,7 +132,8 @@ def _squeeze_evaluate(tables, rows, theory, fixed, columns):
                      eta=_col(rows, "eta"), theory=theory,
                      u_start=_col(rows, "u_start") if "u_start" in rows else None,
                      ratios=tuple(ratios) if ratios else (1.01,), du=tuple(du),
-                     times=tuple(times), method=squeeze_method(len(rows))).reset_index(drop=True)
+                     times=tuple(times),
+                     method=squeeze_method(round(len(rows) * scale))).reset_index(drop=True)
     if len(sq) != len(rows):
         raise RuntimeError(f"squeeze_out returned {len(sq)} rows for {len(rows)} cases")
     out = {name: sq[name].to_numpy() for name in ("u_start", "u_inf", "t_star", *SQUEEZE_TAIL)
@@ -155,7 +157,7 @@ def _tire_infer(axes, fixed, given, problems):
         axes["rho"] = [KINDS["tire"].defaults["rho"]]
 
 
-def _tire_evaluate(tables, rows, theory, fixed, columns):
+def _tire_evaluate(tables, rows, theory, fixed, columns, scale=1.0):
     df = tire_footprint(tables, p0=_col(rows, "p0"), E_star=_col(rows, "E_star"), R=_col(rows, "R"),
                         eta=_col(rows, "eta"), footprint_length=_col(rows, "footprint_length"),
                         speed=_col(rows, "speed"), rho=_col(rows, "rho"), theory=theory,
@@ -199,7 +201,7 @@ def _seal_columns(fixed):
                                  else [])
 
 
-def _seal_evaluate(tables, rows, theory, fixed, columns):
+def _seal_evaluate(tables, rows, theory, fixed, columns, scale=1.0):
     kw = dict(dp=_col(rows, "dp"), L_y=_col(rows, "L_y"), E_star=_col(rows, "E_star"),
               eta=_col(rows, "eta"), theory=theory, alpha_cj=_col(rows, "alpha_cj"),
               p_b=_col(rows, "p_b"), profile=fixed.get("profile", "uniform"))

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import fnmatch
 import json
-import math
 from pathlib import Path
 
 import numpy as np
@@ -18,15 +17,13 @@ try:
 except ModuleNotFoundError:   # Python 3.10
     import tomli as tomllib
 
-from .._core.units import parse_quantity
-from .._core.vocab import CONVENTIONS, THEORIES
-from ..tables.cache import read_table_metadata, surface_mismatch
-from ..tables.defaults import DEFAULT_SURFACES, default_surface
-from .examples import default_table_path, example_scene_path
+from .._core.vocab import THEORIES
+from .examples import example_scene_path
 from .kinds import KINDS
-from .scene import Scene, SceneError, SurfaceSpec, count_cases
-from .schema import (AXIS_KEYS, MAX_CASES, RANGE_KEYS, SCHEMA, SELF_AFFINE_KEYS, STUDY_KINDS,
-                     SURFACE_KEYS, TOP_KEYS, Key, did_you_mean)
+from .scene import Scene, SceneError, count_cases
+from .schema import (AXIS_KEYS, MAX_CASES, RANGE_KEYS, SCHEMA, STUDY_KINDS, TOP_KEYS, Key,
+                     did_you_mean, parse_scalar as _parse_scalar, try_parse as _try)
+from .surfaces import parse_surfaces
 
 __all__ = ["load_scene", "available_figures"]
 
@@ -39,36 +36,9 @@ def available_figures(kind) -> list:
 
 
 # =========================================================================== values
-def _check_bounds(key, x, spec):
-    lo_ok = spec.lo is None or (x > spec.lo if spec.lo_open else x >= spec.lo)
-    hi_ok = spec.hi is None or (x < spec.hi if spec.hi_open else x <= spec.hi)
-    if not (lo_ok and hi_ok):
-        parts = []
-        if spec.lo is not None:
-            parts.append(f"{'>' if spec.lo_open else '>='} {spec.lo:g}")
-        if spec.hi is not None:
-            parts.append(f"{'<' if spec.hi_open else '<='} {spec.hi:g}")
-        raise ValueError(f"{key} = {x!r}: must be {' and '.join(parts)}"
-                         + ("" if spec.dim == "dimensionless" else " [SI]"))
-
-
-def _parse_scalar(key, value, spec):
-    x = parse_quantity(key, value, spec.dim)
-    _check_bounds(key, x, spec)
-    return x
-
-
-def _try(problems, fn, *args):
-    """fn(*args), or None with the ValueError's message appended to ``problems``."""
-    try:
-        return fn(*args)
-    except ValueError as exc:
-        problems.append(str(exc))
-        return None
-
-
 def _parse_range(key, value, spec, problems, max_cases):
-    """List of SI floats of a range table ``{start, stop, num, log}`` (checked before use)."""
+    """SI float64 array of a range table ``{start, stop, num, log}`` (``num`` checked against
+    the study limit before anything is allocated)."""
     unknown = [k for k in value if k not in RANGE_KEYS]
     for k in unknown:
         problems.append(f"{key}.{k}: unknown key in a range table" + did_you_mean(k, RANGE_KEYS))
@@ -94,8 +64,8 @@ def _parse_range(key, value, spec, problems, max_cases):
         if a <= 0 or b <= 0:
             problems.append(f"{key}: a log range needs start and stop > 0")
             return None
-        return [float(x) for x in np.geomspace(a, b, num)]
-    return [float(x) for x in np.linspace(a, b, num)]
+        return np.geomspace(a, b, num)
+    return np.linspace(a, b, num)
 
 
 def _parse_axis(key, value, spec, problems, max_cases):
@@ -329,147 +299,6 @@ def _outputs(kind, fixed, problems):
     return columns, figures
 
 
-# =========================================================================== surfaces
-def _resolve_table_file(value, base):
-    p = Path(value).expanduser()
-    cand = p if p.is_absolute() else base / p
-    return cand if cand.is_file() else default_table_path(value)
-
-
-def _self_affine_params(pre, sd, problems):
-    params = {}
-    for k in SELF_AFFINE_KEYS:
-        if k in sd:
-            x = _try(problems, _parse_scalar, f"{pre}.{k}", sd[k], SURFACE_KEYS[k])
-            if x is not None:
-                params[k] = x
-        elif k != "q_roll":
-            problems.append(f"{pre}.{k} is missing (self-affine surface: h_rms, hurst, q0, q1)")
-    return params
-
-
-def _expected_surface(pre, v, sd, path, problems):
-    """The PSD the scene says a table file holds (its description, or the embedded
-    default of that name), or None if it says nothing."""
-    if any(k in sd for k in SELF_AFFINE_KEYS):
-        params = _self_affine_params(pre, sd, problems)
-        if len(params) >= 4:
-            return _try(problems, lambda: SurfaceSpec("x", "self_affine", params=params).psd())
-        return None
-    name = Path(str(v)).name.removesuffix(".parquet")
-    try:
-        is_default = path.resolve() == default_table_path(name).resolve()
-    except FileNotFoundError:
-        is_default = False
-    return default_surface(name) if is_default and name in DEFAULT_SURFACES else None
-
-
-def _table_surface(pre, name, sd, base, theories, topts_given, problems, label):
-    v, n0 = sd["table"], len(problems)
-    if "convention" in sd or "psd" in sd:
-        problems.append(f"{pre}: a table surface takes table = ... (and optionally the surface's "
-                        f"h_rms, hurst, q0, q1 [, q_roll] to check it), not psd/convention")
-    if not isinstance(v, str):
-        problems.append(f"{pre}.table = {v!r}: must be a file name")
-        return None
-    try:
-        path = _resolve_table_file(v, base)
-    except FileNotFoundError as exc:
-        detail = str(exc)[str(exc).find("(") + 1:-1] if "(" in str(exc) else ""
-        problems.append(f"{pre}.table = {v!r}: file not found" + (f" ({detail})" if detail else ""))
-        return None
-    meta = _try(problems, read_table_metadata, path)
-    if meta is None:
-        problems[-1] = f"{pre}.table = {v!r}: {problems[-1]}"
-        return None
-    missing = [t for t in theories if t not in meta.get("theories", [])]
-    if missing:
-        problems.append(f"{pre}.table = {v!r}: the table holds theories {meta.get('theories')} "
-                        f"but the study needs {missing} (rebuild it with `fastcontact tables "
-                        f"build --theories ...`, or use a psd/self-affine surface)")
-    for k, val in topts_given.items():
-        have = meta.get("options", {}).get(k)
-        if have is not None and not math.isclose(have, val, rel_tol=1e-12):
-            problems.append(f"{pre}.table = {v!r}: built with {k} = {have!r} but tables.{k} = {val!r}")
-    expected = _expected_surface(pre, v, sd, path, problems)
-    bad = None if expected is None else surface_mismatch(meta, expected)
-    if bad:
-        problems.append(f"{pre}.table = {v!r}: {bad}")
-    if len(problems) > n0:
-        return None
-    return SurfaceSpec(name, "table", path=path, label=label, psd_obj=expected)
-
-
-def _psd_surface(pre, name, sd, base, problems, label):
-    v, conv, n0 = sd["psd"], sd.get("convention"), len(problems)
-    if not isinstance(v, str):
-        problems.append(f"{pre}.psd = {v!r}: must be a file name")
-        return None
-    if conv is None:
-        problems.append(f"{pre}.convention is missing: psd files need convention = 'persson' "
-                        f"or 'surface_topography' (contact.engineering)")
-    elif conv not in CONVENTIONS:
-        problems.append(f"{pre}.convention = {conv!r}: must be one of {', '.join(CONVENTIONS)}"
-                        + did_you_mean(conv, CONVENTIONS))
-    p = Path(v).expanduser()
-    p = p if p.is_absolute() else base / p
-    if not p.is_file():
-        problems.append(f"{pre}.psd = {v!r}: file not found ({p})")
-    if len(problems) > n0:
-        return None
-    spec = SurfaceSpec(name, "psd", path=p, convention=conv, label=label)
-    if _try(problems, spec.psd) is None:
-        problems[-1] = f"{pre}.psd = {v!r}: {problems[-1]}"
-        return None
-    return spec
-
-
-def _parse_surface(pre, name, sd, base, theories, topts_given, problems):
-    for k in sd:
-        if k not in SURFACE_KEYS:
-            problems.append(f"{pre}.{k}: unknown key" + did_you_mean(k, list(SURFACE_KEYS)))
-    label = sd.get("label")
-    if label is not None and not isinstance(label, str):
-        problems.append(f"{pre}.label = {label!r}: must be a string")
-    if "table" in sd:
-        return _table_surface(pre, name, sd, base, theories, topts_given, problems, label)
-    has = [s for s in ("psd",) if s in sd] + (["h_rms/hurst/q0/q1"] if any(
-        k in sd for k in SELF_AFFINE_KEYS) else [])
-    if len(has) != 1:
-        problems.append(f"{pre}: give exactly one of table = \"file.parquet\", psd = \"file.csv\" "
-                        f"(+ convention) or h_rms, hurst, q0, q1 [, q_roll]"
-                        + (f" (got {', '.join(has)})" if has else ""))
-        return None
-    if "psd" in sd:
-        return _psd_surface(pre, name, sd, base, problems, label)
-    n0 = len(problems)
-    params = _self_affine_params(pre, sd, problems)
-    if "convention" in sd:
-        problems.append(f"{pre}.convention: only used with psd = ...")
-    if len(problems) > n0:
-        return None
-    spec = SurfaceSpec(name, "self_affine", params=params, label=label)
-    if _try(problems, spec.psd) is None:
-        problems[-1] = f"{pre}: {problems[-1]}"
-        return None
-    return spec
-
-
-def _surfaces(sdict, base, theories, topts_given, for_sweep, problems):
-    if not sdict and not for_sweep:
-        problems.append("[surfaces] is missing: define at least one [surfaces.<name>]")
-    surfaces = {}
-    for name, sd in sdict.items():
-        pre = f"surfaces.{name}"
-        if not isinstance(sd, dict):
-            problems.append(f"{pre} must be a table: [surfaces.{name}] with table/psd/h_rms... keys")
-            continue
-        spec = _parse_surface(pre, name, sd, base, theories, topts_given, problems)
-        if spec is not None:
-            surfaces[name] = spec
-    return surfaces
-
-
 def _check_size(axes, combine, n_surfaces, max_cases, problems):
     """The study's size, counted (nothing allocated), against ``max_cases``."""
     if combine == "zip":
@@ -530,7 +359,7 @@ def load_scene(scene, *, for_sweep=False, base_dir=None, max_cases=None) -> Scen
     _check_material(given, problems)
     topts, topts_given, cache_dir = _table_options(kind, fixed, given, base, problems)
     theories = tuple(t for t in THEORIES if t in axes.get("theory", ()))
-    surfaces = _surfaces(sections["surfaces"], base, theories, topts_given, for_sweep, problems)
+    surfaces = parse_surfaces(sections["surfaces"], base, theories, topts_given, for_sweep, problems)
     columns, figures = _outputs(kind, fixed, problems) if kind is not None else ([], [])
     combine = fixed.pop("combine", "product")
     _check_size(axes, combine, len(sections["surfaces"]), limit, problems)

@@ -126,7 +126,8 @@ def _evaluate_all(scene, tables, path, meta, chunk, prog):
             for cases in scene.chunks(chunk):
                 prog.step(f"{scene.kind} {name} {int(cases.case_id.iloc[0]) if len(cases) else 0}"
                           f"/{scene.n_cases}")
-                res = evaluate_cases(scene.kind, T, cases, scene.fixed, scene.columns)
+                res = evaluate_cases(scene.kind, T, cases, scene.fixed, scene.columns,
+                                     scale=scene.n_cases / max(len(cases), 1))
                 df = pd.concat([pd.DataFrame({"surface": name}, index=cases.index), cases, res],
                                axis=1)
                 bad = df["error"] != ""

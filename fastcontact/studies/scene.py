@@ -30,7 +30,7 @@ from .schema import MAX_CASES
 __all__ = ["Scene", "SurfaceSpec", "SceneError", "DEFAULT_CHUNK"]
 
 #: cases evaluated (and written) per block by :func:`fastcontact.studies.run.run_scene`
-DEFAULT_CHUNK = 250_000
+DEFAULT_CHUNK = 100_000
 
 
 class SceneError(ValueError):
@@ -171,7 +171,7 @@ class Scene:
         cols = {}
         for k, p in zip(names, pos):
             vals = self.axes[k]
-            arr = np.array(vals, dtype=object if k == "theory" else float)
+            arr = np.asarray(vals, dtype=object if k == "theory" else float)
             cols[k] = arr[p]
         df = pd.DataFrame(cols, index=pd.RangeIndex(len(idx)))
         if "E_star" not in self.axes and len(df):
@@ -196,7 +196,8 @@ class Scene:
         return {
             "title": self.title, "kind": self.kind,
             "surfaces": {k: s.describe() for k, s in self.surfaces.items()},
-            "axes": self.axes, "fixed": {k: (list(v) if isinstance(v, tuple) else v)
+            "axes": {k: list(v) if isinstance(v, tuple) else v for k, v in self.axes.items()},
+            "fixed": {k: (list(v) if isinstance(v, tuple) else v)
                                          for k, v in self.fixed.items()},
             "table_options": self.table_options, "columns": self.columns,
             "figures": self.figures, "combine": self.combine,

@@ -4,11 +4,12 @@ from __future__ import annotations
 import dataclasses
 import difflib
 
-from .._core.units import SI_UNITS
+from .._core.units import SI_UNITS, parse_quantity
 from .._core.vocab import CONVENTIONS
 
 __all__ = ["STUDY_KINDS", "Key", "SCHEMA", "SURFACE_KEYS", "TOP_KEYS", "AXIS_KEYS", "RANGE_KEYS",
-           "SELF_AFFINE_KEYS", "MAX_CASES", "did_you_mean", "input_units"]
+           "SELF_AFFINE_KEYS", "MAX_CASES", "did_you_mean", "input_units", "parse_scalar",
+           "check_bounds", "try_parse"]
 
 STUDY_KINDS = ("squeeze", "tire", "seal")
 #: largest study (cases x surfaces) a scene may ask for unless ``[outputs] max_cases`` or
@@ -147,3 +148,33 @@ def did_you_mean(word, choices) -> str:
     if close:
         return f" (did you mean {close[0]!r}?)"
     return f" (allowed: {', '.join(map(str, choices))})"
+
+
+def check_bounds(key, x, spec):
+    """Raise ValueError naming ``key`` if ``x`` is outside the bounds of ``spec``."""
+    lo_ok = spec.lo is None or (x > spec.lo if spec.lo_open else x >= spec.lo)
+    hi_ok = spec.hi is None or (x < spec.hi if spec.hi_open else x <= spec.hi)
+    if not (lo_ok and hi_ok):
+        parts = []
+        if spec.lo is not None:
+            parts.append(f"{'>' if spec.lo_open else '>='} {spec.lo:g}")
+        if spec.hi is not None:
+            parts.append(f"{'<' if spec.hi_open else '<='} {spec.hi:g}")
+        raise ValueError(f"{key} = {x!r}: must be {' and '.join(parts)}"
+                         + ("" if spec.dim == "dimensionless" else " [SI]"))
+
+
+def parse_scalar(key, value, spec):
+    """SI float of ``value`` for the key ``spec`` (unit, dimension and bounds checked)."""
+    x = parse_quantity(key, value, spec.dim)
+    check_bounds(key, x, spec)
+    return x
+
+
+def try_parse(problems, fn, *args):
+    """fn(*args), or None with the ValueError's message appended to ``problems``."""
+    try:
+        return fn(*args)
+    except ValueError as exc:
+        problems.append(str(exc))
+        return None
