@@ -1,0 +1,348 @@
+"""Directional flow conductivities σ_xx, σ_yy for anisotropic roughness (Tripp/Peklenik γ_T).
+
+The roughness is stretched along x: γ_T = ξ_x/ξ_y >= 1 is the ratio of the correlation
+lengths (Peklenik number; "x" = along the grooves of a machined or brushed surface). The
+contact mechanics (A(ζ), u1(ζ), P(u)) is that of the angle-averaged spectrum C(q) (Persson
+2010: the anisotropy enters the flow, not the area); the non-contact and contact patches
+become ellipses of aspect ratio γ_T aligned with x, and the 2-D Bruggeman medium uses their
+depolarization factors (docs/theory/extensions.md §3):
+
+``form="self_consistent"`` (default): the depolarization factor of an ellipse in the
+    *anisotropic* effective medium (affine map to an isotropic host, Stroud 1975),
+    n_x = 1/(1 + λ), λ = γ_T √(σ_yy/σ_xx); two coupled equations
+    ∫ P(u) (σ(u) - σ_xx)/(λ σ_xx + σ(u)) du = 0 and the same in y with 1/λ.
+    Both conductivities vanish together at A(ζ1)/A0 = 1/2, with σ_yy/σ_xx → 1/γ_T² there
+    (the threshold is independent of γ_T, as Persson 2020 finds).
+``form="fixed"``: depolarization in an isotropic host, n_x = 1/(1 + γ_T):
+    1/σ_xx = ∫ P(u) (1 + γ_T)/(γ_T σ_xx + σ(u)) du (the flow-tensor form of Persson 2010);
+    σ_xx percolates at A/A0 = γ_T/(1 + γ_T), σ_yy at 1/(1 + γ_T).
+
+theory "critical_junction" (form "fixed" only): the junction sits where A(ζc)/A0 reaches the
+directional threshold, the isotropic a_perc mapped by its odds, a_x/(1 - a_x) =
+γ_T a_perc/(1 - a_perc). theory "average": σ = ū³/(12η) carries no direction (returned as is).
+γ_T = 1 returns the isotropic :func:`fastcontact.flow.conductivity.conductivity` exactly.
+
+References: B.N.J. Persson, J. Phys.: Condens. Matter 22, 265004 (2010),
+doi:10.1088/0953-8984/22/26/265004; B.N.J. Persson, Eur. Phys. J. E 43, 25 (2020),
+doi:10.1140/epje/i2020-11950-2; D. Stroud, Phys. Rev. B 12, 3368 (1975),
+doi:10.1103/PhysRevB.12.3368; J.H. Tripp, J. Lubr. Technol. 105, 458 (1983),
+doi:10.1115/1.3254641.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from scipy.interpolate import CubicSpline
+from scipy.special import erf, erfinv
+
+from .._core.validate import check_positive, check_range
+from ..contact import area_fraction, percolation_pressure, u1
+from .conductivity import check_theory, conductivity
+
+__all__ = ["sigma_directional", "directional_sigma_bar", "DirectionalTable",
+           "precompute_directional", "FORMS", "N_PANELS"]
+
+FORMS = ("self_consistent", "fixed")
+#: composite Gauss–Legendre panels (order 10) in the graded variable t of A (see Notes)
+N_PANELS = 24
+GL_ORDER = 10
+GRADE = 3.0
+
+
+# =========================================================================== Bruggeman
+@njit(cache=True)
+def _residual(s, W, sig, A1, lam):
+    """Σ W (1+λ)s/(λs + σ_j) + A1(1+λ)/λ - 1 and its derivative in ln s."""
+    f = A1 * (1.0 + lam) / lam - 1.0
+    df = 0.0
+    for j in range(W.size):
+        d = lam * s + sig[j]
+        f += W[j] * (1.0 + lam) * s / d
+        df += W[j] * (1.0 + lam) * s * sig[j] / (d * d)
+    return f, df
+
+
+@njit(cache=True)
+def _solve_dir(W, sig, A1, lam):
+    """σ̄ with ∫P (σ - s)/(λ s + σ) = 0 (depolarization 1/(1+λ)); 0 if A1 >= λ/(1+λ)."""
+    if A1 >= lam / (1.0 + lam):
+        return 0.0
+    smax = 0.0
+    for j in range(sig.size):
+        if sig[j] > smax:
+            smax = sig[j]
+    lo = -700.0
+    hi = math.log(smax) + 2.0 + math.log(1.0 + 1.0 / lam)
+    y = 0.5 * (lo + hi)
+    for _ in range(300):
+        f, df = _residual(math.exp(y), W, sig, A1, lam)
+        if f > 0.0:
+            hi = y
+        else:
+            lo = y
+        yn = y - f / df if df > 0.0 else 0.5 * (lo + hi)
+        if not (lo < yn < hi):
+            yn = 0.5 * (lo + hi)
+        if abs(yn - y) < 1e-15 * max(1.0, abs(y)) or hi - lo < 1e-15:
+            return math.exp(yn)
+        y = yn
+    return math.exp(y)
+
+
+@njit(cache=True)
+def _solve_self_consistent(W, sig, A1, gam):
+    """(σ̄_xx, σ̄_yy) with λ = γ √(σ_yy/σ_xx) found by bisection/secant in ln λ."""
+    if A1 >= 0.5:
+        return 0.0, 0.0
+    lo = math.log(A1 / (1.0 - A1)) if A1 > 0.0 else -60.0
+    hi = -lo
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lam = math.exp(mid)
+        sx = _solve_dir(W, sig, A1, lam)
+        sy = _solve_dir(W, sig, A1, 1.0 / lam)
+        if sx <= 0.0:
+            lo = mid
+            continue
+        if sy <= 0.0:
+            hi = mid
+            continue
+        h = mid - math.log(gam) - 0.5 * (math.log(sy) - math.log(sx))
+        if h > 0.0:
+            hi = mid
+        else:
+            lo = mid
+        if hi - lo < 1e-14:
+            return sx, sy
+    lam = math.exp(0.5 * (lo + hi))
+    return _solve_dir(W, sig, A1, lam), _solve_dir(W, sig, A1, 1.0 / lam)
+
+
+# =========================================================================== P(u) nodes
+def _zeta_of_area(psd, pbar, area):
+    """ζ with A(ζ)/A0 = area at reduced pressure pbar (bisection in ln q on the closed-form
+    moment ∫_{q0}^{q} q³C dq = (4/π)(p̄/(2 erfinv A))²)."""
+    target = 4.0 / math.pi * (pbar / (2.0 * erfinv(area))) ** 2
+    lo = np.full(area.shape, math.log(psd.q0))
+    hi = np.full(area.shape, math.log(psd.q1))
+    for _ in range(64):
+        mid = 0.5 * (lo + hi)
+        m = np.asarray(psd.moment(3.0, psd.q0, np.exp(mid)))
+        big = m > target
+        hi = np.where(big, mid, hi)
+        lo = np.where(big, lo, mid)
+    return np.clip(np.exp(0.5 * (lo + hi)) / psd.q0, 1.0, psd.zeta1)
+
+
+def _nodes(psd, pbar, gamma, n_panels):
+    """(W, σ̄_j = (u1/h)³, A1): the u1-based P(u) of SPEC-style EMT on graded GL nodes in A."""
+    A1 = float(erf(pbar / (2.0 * math.sqrt(0.25 * math.pi * psd.cum3[-1]))))
+    x, w = np.polynomial.legendre.leggauss(GL_ORDER)
+    edges = np.linspace(0.0, 1.0, n_panels + 1)
+    half = 0.5 * np.diff(edges)
+    t = (0.5 * (edges[:-1] + edges[1:])[:, None] + half[:, None] * x[None, :]).ravel()
+    wt = (half[:, None] * w[None, :]).ravel()
+    m = GRADE
+    tm, om = t ** m, (1.0 - t) ** m
+    s = tm / (tm + om)
+    ds = m * (t * (1.0 - t)) ** (m - 1.0) / (tm + om) ** 2
+    area = A1 + (1.0 - A1) * s
+    W = (1.0 - A1) * ds * wt
+    ok = (area < 1.0) & (area > A1)
+    zeta = _zeta_of_area(psd, pbar, np.where(ok, area, 0.5))
+    u = u1(psd, pbar, 1.0, zeta, gamma)
+    mask = np.ma.getmaskarray(u) | ~ok
+    sig = (np.ma.filled(u, 0.0) / psd.h_rms) ** 3
+    W = np.where(mask, 0.0, W)
+    return np.ascontiguousarray(W), np.ascontiguousarray(np.where(mask, 0.0, sig)), A1
+
+
+def directional_sigma_bar(psd, pbar, anisotropy, *, form="self_consistent", gamma=1.0,
+                          n_panels=N_PANELS):
+    """(σ̄_xx, σ̄_yy) = 12ησ/h_rms³ [-] of the anisotropic Bruggeman medium at p̄ = p/E*.
+
+    Always runs the anisotropic solver (also at γ_T = 1; used to test continuity).
+    """
+    pbar = np.atleast_1d(np.asarray(pbar, dtype=np.float64)).ravel()
+    sx = np.empty(pbar.size)
+    sy = np.empty(pbar.size)
+    for i, pb in enumerate(pbar):
+        W, sig, A1 = _nodes(psd, float(pb), gamma, int(n_panels))
+        if form == "self_consistent":
+            sx[i], sy[i] = _solve_self_consistent(W, sig, A1, float(anisotropy))
+        else:
+            sx[i] = _solve_dir(W, sig, A1, float(anisotropy))
+            sy[i] = _solve_dir(W, sig, A1, 1.0 / float(anisotropy))
+    return sx, sy
+
+
+def _check(theory, anisotropy, direction, form):
+    check_theory(theory)
+    g = float(check_range("anisotropy", anisotropy, 1.0, math.inf, "[-] (Peklenik number "
+                          "γ_T = ξ_x/ξ_y >= 1; put the long correlation length along x)",
+                          hi_open=True))
+    if direction not in ("x", "y"):
+        raise ValueError(f"direction = {direction!r} is invalid: must be 'x' (along the long "
+                         f"correlation length) or 'y'")
+    if form not in FORMS:
+        raise ValueError(f"form = {form!r} is invalid: must be one of {list(FORMS)}")
+    if theory == "critical_junction" and form != "fixed" and g != 1.0:
+        raise ValueError("form = 'self_consistent' is invalid with theory = "
+                         "'critical_junction': the directional junction is defined for "
+                         "form = 'fixed' (directional percolation thresholds) only")
+    return g
+
+
+def directional_threshold(a_perc, anisotropy, direction):
+    """Directional percolation area fraction of the 'fixed' form: odds scaled by γ_T^{±1}."""
+    g = anisotropy if direction == "x" else 1.0 / anisotropy
+    return g * a_perc / (1.0 - a_perc + g * a_perc)
+
+
+def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, direction="x", *,
+                      form="self_consistent", gamma=1.0, a_perc=0.5, alpha_cj=1.0,
+                      n_panels=N_PANELS):
+    """Directional interfacial conductivity σ_xx or σ_yy [m³/(Pa·s)] by direct quadrature.
+
+    Parameters
+    ----------
+    psd : PSD
+        Angle-averaged roughness spectrum (Persson convention).
+    p : array_like
+        Contact pressure p_cont [Pa], > 0.
+    E_star : float
+        Effective modulus [Pa], > 0.
+    eta : float
+        Fluid viscosity [Pa·s], > 0.
+    theory : {"emt", "critical_junction", "average"}
+        Flow theory (module docstring).
+    anisotropy : float
+        Peklenik/Tripp number γ_T = ξ_x/ξ_y >= 1 [-]; 1 = isotropic (exactly the
+        isotropic :func:`~fastcontact.flow.conductivity.conductivity`).
+    direction : {"x", "y"}
+        Flow along the long correlation length ("x", the grooves) or across it ("y").
+    form : {"self_consistent", "fixed"}
+        Depolarization factors in the anisotropic effective medium or in an isotropic host.
+    gamma, a_perc, alpha_cj :
+        As in :func:`~fastcontact.flow.conductivity.conductivity`.
+    n_panels : int
+        Gauss–Legendre panels (order 10) of the P(u) quadrature in A (EMT).
+
+    Returns
+    -------
+    (sigma [m³/(Pa·s)], percolated [bool]) arrays of p's shape.
+    """
+    g = _check(theory, anisotropy, direction, form)
+    p = check_positive("p", p, "[Pa]")
+    E_star = float(check_positive("E_star", E_star, "[Pa]"))
+    eta = float(check_positive("eta", eta, "[Pa·s]"))
+    if g == 1.0 or theory == "average":
+        return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_perc,
+                            alpha_cj=alpha_cj)
+    if theory == "critical_junction":
+        a_dir = directional_threshold(float(a_perc), g, direction)
+        return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_dir,
+                            alpha_cj=alpha_cj)
+    sx, sy = directional_sigma_bar(psd, np.ravel(p) / E_star, g, form=form, gamma=gamma,
+                                   n_panels=n_panels)
+    sb = (sx if direction == "x" else sy).reshape(np.shape(p))
+    a_thr = 0.5 if form == "self_consistent" else directional_threshold(0.5, g, direction)
+    perc = np.asarray(area_fraction(psd, p, E_star)) >= a_thr
+    return sb * psd.h_rms ** 3 / (12.0 * eta), perc
+
+
+# =========================================================================== table path
+class DirectionalTable:
+    """σ̄_xx(p̄), σ̄_yy(p̄) of one surface and γ_T on the nodes of a :class:`Tables`.
+
+    Interpolation: not-a-knot cubic spline of ln σ̄ in ln p̄ between open nodes; in the last
+    interval before the (exact) percolation pressure σ̄^(1/3) falls linearly to 0 (as the
+    tables do). ``info["interpolation_error"]`` holds the worst relative midpoint error.
+    """
+
+    def __init__(self, tables, anisotropy, theory, form, lnp, lnsig, lnp_perc, info):
+        self.tables = tables
+        self.anisotropy = float(anisotropy)
+        self.theory = theory
+        self.form = form
+        self.h_rms = float(tables.h_rms)
+        self.lnp = lnp
+        self.lnsig = lnsig                 # dict direction -> ln σ̄ (-inf where closed)
+        self.lnp_perc = lnp_perc           # dict direction -> ln p̄ of percolation
+        self.info = info
+        self._spl = {}
+        for d in ("x", "y"):
+            ok = np.isfinite(lnsig[d])
+            self._spl[d] = (CubicSpline(lnp[ok], lnsig[d][ok]), int(ok.sum()))
+
+    def sigma_bar(self, p, E_star, direction="x"):
+        """σ̄ [-] in ``direction`` at contact pressure p [Pa]; 0 beyond percolation."""
+        if direction not in ("x", "y"):
+            raise ValueError(f"direction = {direction!r} is invalid: must be 'x' or 'y'")
+        pb = np.asarray(self.tables._pbar("p", p, E_star), dtype=np.float64)
+        x = np.log(pb)
+        spl, n_open = self._spl[direction]
+        lnp = self.lnp
+        last = lnp[n_open - 1]
+        xp = self.lnp_perc[direction]
+        out = np.exp(spl(np.minimum(x, last)))
+        tail = (x > last) & (x < xp)
+        if np.any(tail):
+            c = np.exp(self.lnsig[direction][n_open - 1] / 3.0) * (xp - x[tail]) / (xp - last)
+            out = np.where(tail, 0.0, out)
+            out[tail] = c ** 3
+        return np.where(x >= xp, 0.0, out)[()]
+
+    def conductivity(self, p, E_star, eta, direction="x"):
+        """σ [m³/(Pa·s)] in ``direction`` at contact pressure p [Pa]."""
+        eta = check_positive("eta", eta, "[Pa·s]")
+        return self.sigma_bar(p, E_star, direction) * self.h_rms ** 3 / (12.0 * eta)
+
+
+def precompute_directional(tables, anisotropy, *, theory="emt", form="self_consistent",
+                           n_panels=N_PANELS):
+    """Tabulate σ̄_xx, σ̄_yy of ``tables.surface`` with γ_T = ``anisotropy`` on the tables' nodes.
+
+    The tables' options (γ of Yang–Persson) are reused; the worst relative error of the
+    spline at every interval midpoint (against the direct solver) is recorded in ``info``.
+    """
+    import time
+
+    t0 = time.perf_counter()
+    g = _check(theory, anisotropy, "x", form)
+    if theory != "emt":
+        raise ValueError(f"theory = {theory!r} is invalid for precompute_directional: the "
+                         f"table path is for 'emt' (critical junction: use tables built with "
+                         f"the directional a_perc, see directional_threshold)")
+    psd = tables.surface
+    gamma = float(tables.options.get("gamma", 1.0))
+    pbar = np.asarray(tables.data["p_over_E"], dtype=np.float64)
+    lnp = np.log(pbar)
+    thr = {"x": 0.5, "y": 0.5} if form == "self_consistent" else \
+        {d: directional_threshold(0.5, g, d) for d in ("x", "y")}
+    lnp_perc = {d: math.log(float(percolation_pressure(psd, 1.0, thr[d]))) for d in thr}
+    sx, sy = directional_sigma_bar(psd, pbar, g, form=form, gamma=gamma, n_panels=n_panels)
+    with np.errstate(divide="ignore"):
+        lnsig = {"x": np.where(sx > 1e-300, np.log(np.maximum(sx, 1e-300)), -np.inf),
+                 "y": np.where(sy > 1e-300, np.log(np.maximum(sy, 1e-300)), -np.inf)}
+    for d in ("x", "y"):   # closed from the first node at/after percolation on
+        lnsig[d] = np.where(lnp >= lnp_perc[d], -np.inf, lnsig[d])
+        first = np.argmax(~np.isfinite(lnsig[d])) if np.any(~np.isfinite(lnsig[d])) else lnp.size
+        lnsig[d][first:] = -np.inf
+    tab = DirectionalTable(tables, g, theory, form, lnp, lnsig, lnp_perc, {})
+    # midpoint errors (σ̄ above 1e-20: below it times and leak rates are negligible)
+    xm = 0.5 * (lnp[:-1] + lnp[1:])
+    mx, my = directional_sigma_bar(psd, np.exp(xm), g, form=form, gamma=gamma,
+                                   n_panels=n_panels)
+    err = {}
+    for d, m in (("x", mx), ("y", my)):
+        est = tab.sigma_bar(np.exp(xm), 1.0, d)
+        ok = (m > 1e-20) & (est > 0)
+        err[d] = float(np.max(np.abs(est[ok] / m[ok] - 1.0))) if np.any(ok) else 0.0
+    tab.info.update({"interpolation_error": err, "nodes": int(lnp.size),
+                     "percolation_p_over_E": {d: math.exp(v) for d, v in lnp_perc.items()},
+                     "anisotropy": g, "form": form, "n_panels": int(n_panels),
+                     "build_seconds": time.perf_counter() - t0})
+    return tab
