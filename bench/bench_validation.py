@@ -7,6 +7,9 @@ grid convergence from seed 0 at n = 128 (every H) and n = 512 (H = 0.7). Writes 
 bench/validation_errors.png, bench/validation_constants.png and bench/validation_*.parquet.
 
 Run: python bench/bench_validation.py   (about 10 min on 2 idle cores)
+     python bench/bench_validation.py --H 0.7      one surface (run several in parallel), then
+     python bench/bench_validation.py --collect    comparisons, figures and VALIDATION.md
+     (FASTCONTACT_BENCH_REUSE=1 reuses a saved validation_ref_H*.parquet)
 """
 from __future__ import annotations
 
@@ -81,63 +84,101 @@ def summarize(cmp, label):
     return out
 
 
-def main():
-    t_all = time.perf_counter()
+def run_one(H):
+    """BEM reference, convergence runs and calibration of one H; saves them beside this file."""
+    import json
+
+    warnings.simplefilter("ignore")
+    psd = surface(H)
+    p = np.asarray(contact.percolation_pressure(psd, E_STAR, A_TARGET))
+    times = {}
+    ref_path = HERE / f"validation_ref_H{H}.parquet"
+    t0 = time.perf_counter()
+    if os.environ.get("FASTCONTACT_BENCH_REUSE") == "1" and ref_path.exists():
+        from fastcontact.validation.compare import read_reference
+        ref = read_reference(ref_path)
+        times["main"] = ref.attrs["provenance"]["seconds"]
+    else:
+        ref = bem_reference(psd, E_STAR, p, n=N_MAIN, seeds=SEEDS, eta=ETA, grid_check=False,
+                            progress=False, stop_bisections=STOP_BISECTIONS)
+        times["main"] = time.perf_counter() - t0
+        write_reference(ref, ref_path)
+    print(f"H={H}: BEM done in {times['main']:.0f} s", flush=True)
+    t0 = time.perf_counter()
+    coarse = bem_reference(psd, E_STAR, p, n=N_COARSE, seeds=SEEDS[:1], eta=ETA,
+                           grid_check=False, progress=False, stop_bisections=STOP_BISECTIONS)
+    fine = None
+    if H in FINE_FOR:
+        fine = bem_reference(psd, E_STAR, p, n=N_FINE, seeds=SEEDS[:1], eta=ETA,
+                             grid_check=False, progress=False, stop_bisections=STOP_BISECTIONS)
+    times["conv"] = time.perf_counter() - t0
+    conv = []
+    s0 = ref.attrs["per_seed"][str(SEEDS[0])]
+    for col in ("area_fraction", "u_mean", "sigma_eff"):
+        m = np.asarray(s0[col])
+        c = coarse[col].to_numpy(float)
+        ok = (m > 0) & (c > 0)
+        cm = float(np.max(np.abs(c[ok] / m[ok] - 1))) if ok.any() else math.nan
+        mf = math.nan
+        if fine is not None:
+            f = fine[col].to_numpy(float)
+            okf = (m > 0) & (f > 0)
+            mf = float(np.max(np.abs(m[okf] / f[okf] - 1))) if okf.any() else math.nan
+        conv.append((H, col, cm, mf))
+    st_m = ref.attrs["flow_stop_per_seed"][str(SEEDS[0])]
+    st_c = coarse.attrs["flow_stop_pressure"]
+    st_f = fine.attrs["flow_stop_pressure"] if fine is not None else math.nan
+    conv.append((H, "flow_stop", abs(st_c / st_m - 1), abs(st_m / st_f - 1)))
+    t0 = time.perf_counter()
+    cal = calibrate(psd, E_STAR, ref)
+    times["cal"] = time.perf_counter() - t0
+    cal.to_toml(HERE / f"validation_calibration_H{H}.toml")
+    (HERE / f"validation_run_H{H}.json").write_text(json.dumps(
+        {"conv": conv, "times": times, "machine": machine()}, indent=1), encoding="utf-8")
+    print(f"H={H}: convergence {times['conv']:.0f} s, calibration {times['cal']:.0f} s", flush=True)
+
+
+def collect(total=None):
+    """Comparisons, figures and VALIDATION.md from the saved per-H runs."""
+    import json
+
+    from fastcontact.validation import Calibration
+    from fastcontact.validation.compare import read_reference
+
     warnings.simplefilter("ignore")
     rows, cals, conv, times, comps = [], {}, [], {}, {}
     for H in HURST:
-        psd = surface(H)
-        p = np.asarray(contact.percolation_pressure(psd, E_STAR, A_TARGET))
-        t0 = time.perf_counter()
-        ref = bem_reference(psd, E_STAR, p, n=N_MAIN, seeds=SEEDS, eta=ETA, grid_check=False,
-                            progress=False, stop_bisections=STOP_BISECTIONS)
-        print(f"H={H}: BEM done in {time.perf_counter() - t0:.0f} s", flush=True)
-        times[(H, "main")] = time.perf_counter() - t0
-        write_reference(ref, HERE / f"validation_ref_H{H}.parquet")
-        t0 = time.perf_counter()
-        coarse = bem_reference(psd, E_STAR, p, n=N_COARSE, seeds=SEEDS[:1], eta=ETA,
-                               grid_check=False, progress=False, stop_bisections=STOP_BISECTIONS)
-        fine = None
-        if H in FINE_FOR:
-            fine = bem_reference(psd, E_STAR, p, n=N_FINE, seeds=SEEDS[:1], eta=ETA,
-                                 grid_check=False, progress=False,
-                                 stop_bisections=STOP_BISECTIONS)
-        times[(H, "conv")] = time.perf_counter() - t0
-        s0 = ref.attrs["per_seed"][str(SEEDS[0])]
-        for col in ("area_fraction", "u_mean", "sigma_eff"):
-            m = np.asarray(s0[col])
-            c = coarse[col].to_numpy(float)
-            f = fine[col].to_numpy(float) if fine is not None else None
-            ok = (m > 0) & (c > 0)
-            cm = float(np.max(np.abs(c[ok] / m[ok] - 1))) if ok.any() else math.nan
-            mf = math.nan
-            if f is not None:
-                okf = (m > 0) & (f > 0)
-                mf = float(np.max(np.abs(m[okf] / f[okf] - 1))) if okf.any() else math.nan
-            conv.append((H, col, cm, mf))
-        st_m = ref.attrs["flow_stop_per_seed"][str(SEEDS[0])]
-        st_c = coarse.attrs["flow_stop_pressure"]
-        st_f = fine.attrs["flow_stop_pressure"] if fine is not None else math.nan
-        conv.append((H, "flow_stop", abs(st_c / st_m - 1), abs(st_m / st_f - 1)))
-        t0 = time.perf_counter()
-        cal = calibrate(psd, E_STAR, ref)
-        times[(H, "cal")] = time.perf_counter() - t0
-        cal.to_toml(HERE / f"validation_calibration_H{H}.toml")
+        run = json.loads((HERE / f"validation_run_H{H}.json").read_text(encoding="utf-8"))
+        conv += [tuple(r) for r in run["conv"]]
+        for k, v in run["times"].items():
+            times[(H, k)] = v
+        ref = read_reference(HERE / f"validation_ref_H{H}.parquet")
+        cal = Calibration.from_toml(HERE / f"validation_calibration_H{H}.toml")
         cals[H] = cal
-        cmp = compare_theories(psd, E_STAR, ref, calibration=cal)
+        cmp = compare_theories(surface(H), E_STAR, ref, calibration=cal)
         comps[H] = cmp
         for label in ("average", "critical_junction", "emt", "average+cal",
                       "critical_junction+cal", "emt+cal"):
             rows.append((H, label, summarize(cmp, label)))
-        rows_ref = ref
-        print(f"H={H}: BEM {times[(H, 'main')]:.0f} s, convergence {times[(H, 'conv')]:.0f} s, "
-              f"calibration {times[(H, 'cal')]:.0f} s; stop {ref.attrs['flow_stop_pressure']:.4g} Pa",
-              flush=True)
-        del rows_ref
-    total = time.perf_counter() - t_all
+    if total is None:
+        total = sum(times.values())
     figures(comps, cals)
     write_md(rows, cals, conv, times, total, comps)
-    print(f"total {total:.0f} s")
+
+
+def main():
+    args = sys.argv[1:]
+    if args[:1] == ["--H"]:
+        run_one(float(args[1]))
+        return
+    if args[:1] == ["--collect"]:
+        collect()
+        return
+    t_all = time.perf_counter()
+    for H in HURST:
+        run_one(H)
+    collect(time.perf_counter() - t_all)
+    print(f"total {time.perf_counter() - t_all:.0f} s")
 
 
 def figures(comps, cals):
@@ -185,8 +226,10 @@ def rng(t, spec=".2g"):
 def write_md(rows, cals, conv, times, total, comps):
     L_ = []
     L_.append("# Validation of the theories against a BEM + Reynolds reference (issue 13)\n")
-    L_.append(f"Machine: {machine()}. Total wall time {total:.0f} s "
-              f"(`python bench/bench_validation.py`).\n")
+    L_.append(f"Machine: {machine()}. Sum of the stage wall times {total:.0f} s "
+              f"(`python bench/bench_validation.py`; the runs below shared the 2 cores with "
+              f"other jobs at load ≈ 13, so they are several times slower than on an idle "
+              f"machine).\n")
     L_.append(f"Surfaces: self-affine, h_rms = 1 µm, box 1 mm = 2π/q0, roll-off q_r = 4 q0, "
               f"q1 = 32 q0, H = {', '.join(map(str, HURST))}; E* = 10 MPa, η = 1 mPa·s. "
               f"Reference: `fastcontact.bem_reference`, n = {N_MAIN} "

@@ -127,3 +127,9 @@ def test_compare_theory_against_itself(psd, tmp_path):
     assert c.attrs["flow_stop"]["emt"]["ratio"] == pytest.approx(1.0, rel=1e-12)
     with pytest.raises(ValueError, match="E_star"):
         compare_theories(psd, -1, ref)
+
+
+def test_top_level_names():
+    import fastcontact.validation as v
+    assert fc.calibrate is v.calibrate and fc.Calibration is v.Calibration
+    assert fc.compare_theories is v.compare_theories and fc.bem_reference is v.bem_reference
