@@ -29,6 +29,9 @@ from pathlib import Path
 __all__ = ["main", "build_parser"]
 
 EXIT_BAD_INPUT = 2
+#: optional packages and the extra that installs them
+_EXTRAS = {"dask": "distributed", "distributed": "distributed", "SurfaceTopography": "topography",
+           "ContactMechanics": "bem", "matplotlib": "plots"}
 
 
 class CLIError(ValueError):
@@ -373,7 +376,7 @@ def _cmd_figures(a, out, err):
             if exc.name and mod.startswith(exc.name):
                 raise SystemExit(f"fastcontact figures: figure module {mod} is missing "
                                  f"({exc}); cannot regenerate every paper figure") from None
-            raise
+            raise   # an optional dependency (matplotlib): main() reports it in one line
         if not hasattr(m, fn):
             raise SystemExit(f"fastcontact figures: {mod} has no {fn}()")
         funcs.append((mod, getattr(m, fn)))
@@ -443,6 +446,16 @@ def main(argv=None, out=None, err=None):
         prefix = "" if msg.startswith("fastcontact") else "fastcontact: error: "
         print(prefix + msg, file=err)
         return EXIT_BAD_INPUT
+    except ModuleNotFoundError as exc:
+        # an optional part that is not installed: one line naming what to install
+        top = (exc.name or "").split(".")[0]
+        if top == "fastcontact" or not top:
+            raise
+        extra = _EXTRAS.get(top)
+        hint = f"pip install 'fastcontact[{extra}]'" if extra else f"pip install {top}"
+        print(f"fastcontact: error: this needs the optional package {top!r}, which is not "
+              f"installed ({hint})", file=err)
+        return 1
     except KeyboardInterrupt as exc:
         # a sweep's SweepInterrupted carries a one-line message and 130 (SIGINT) / 143 (SIGTERM)
         print(f"fastcontact: {exc}" if str(exc) else "fastcontact: interrupted", file=err)

@@ -166,3 +166,28 @@ def test_cache_dir_from_platformdirs(monkeypatch):
     assert table_cache_dir() == Path(user_cache_dir("fastcontact")) / "tables"
     monkeypatch.setenv("FASTCONTACT_CACHE_DIR", "/somewhere")
     assert table_cache_dir() == Path("/somewhere")
+
+
+def test_missing_optional_package_one_line(monkeypatch):
+    import fastcontact.cli as c
+
+    def boom(a, out, err):
+        raise ModuleNotFoundError("No module named 'distributed'", name="distributed")
+    monkeypatch.setattr(c, "_cmd_sweep", boom)
+    code, _, err = cli("sweep", "db", "-o", "x", "--scene", "default")
+    assert code == 1 and len(err.strip().splitlines()) == 1
+    assert "fastcontact[distributed]" in err and "Traceback" not in err
+
+
+def test_missing_matplotlib_skips_figures_with_one_line(tmp_path, monkeypatch):
+    import importlib.util
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == "matplotlib" else real(name, *a))
+    code, out, err = cli("run", "--default", "-o", tmp_path / "o", "-q")
+    assert code == 0, err
+    assert "matplotlib is not installed" in err and len(err.strip().splitlines()) == 1
+    assert (tmp_path / "o" / "results.parquet").is_file() and (tmp_path / "o" / "summary.txt").is_file()
+    assert not (tmp_path / "o" / "figures").exists()
+    rec = json.loads((tmp_path / "o" / "build_record.json").read_text())
+    assert "not made" in rec["figures_note"]

@@ -23,8 +23,8 @@ from pathlib import Path
 import matplotlib.ticker
 import numpy as np
 
-from fastcontact.squeeze.reduced import flat_separation_reduced, squeeze_out_reduced, u_of_t_reduced
-from fastcontact.figures.canvas import new_figure as _new_figure, save_png as _save_atomic
+from ..squeeze.reduced import flat_separation_reduced, squeeze_out_reduced, u_of_t_reduced
+from .canvas import new_figure as _new_figure, save_png as _save_atomic
 
 __all__ = ["make_reduced_figures"]
 

@@ -1,6 +1,6 @@
 """The paper's seal experiment (Secs. 7–8): leak rate against Δp and the profiles across the ring.
 
-Set-up (SPEC §7): PDMS ring (Sylgard 184, E = 2.3 MPa, ν = 0.5 → E* = E/(1 − ν²) = 3.07 MPa),
+Set-up (paper Sec. 7): PDMS ring (Sylgard 184, E = 2.3 MPa, ν = 0.5 → E* = E/(1 − ν²) = 3.07 MPa),
 inner/outer diameter 4/6 cm → seal width L = 1 cm and length L_y = π·5 cm (mean circumference),
 nominal pressure p0 = 11.8 kPa (uniform: flat ring), water (η = 1.0 mPa·s) column up to
 H = 1.2 m → Δp = ρgH up to 11.8 kPa = p0, p_b = 0, junction factor α_cj = 0.54.
@@ -34,9 +34,13 @@ from pathlib import Path
 
 import matplotlib.ticker
 import numpy as np
+import pandas as pd
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from fastcontact._core.io import atomic_path
+
+from .._core.io import atomic_path
+from ..seal import seal_leak, seal_profile
+from ..tables.defaults import load_default_tables
 
 __all__ = ["make_seal_figures", "seal_experiment", "EXPERIMENT"]
 
@@ -89,8 +93,6 @@ def _new_figure(**kw):
 def _tables(tables):
     if tables is not None:
         return tables
-    from fastcontact.tables.defaults import load_default_tables
-
     return load_default_tables(SURFACE)
 
 
@@ -104,10 +106,6 @@ def _description(tables):
 
 # --------------------------------------------------------------------------- experiment
 def _leak_table(tables):
-    import pandas as pd
-
-    from fastcontact.seal import seal_leak
-
     ex = EXPERIMENT
     p0 = ex["p0"]
     # dense towards Δp = p0, where Q rises steeply (infinite slope at the lift-off equality)
@@ -127,10 +125,6 @@ def _leak_table(tables):
 
 
 def _profiles(tables, n=401):
-    import pandas as pd
-
-    from fastcontact.seal import seal_profile
-
     ex = EXPERIMENT
     frames = []
     for r in RATIOS:

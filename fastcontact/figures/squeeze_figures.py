@@ -29,7 +29,11 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from fastcontact.figures.canvas import new_figure as _new_figure, save_png as _save_atomic
+
+from ..squeeze import squeeze_history
+from ..surface.psd import SelfAffinePSD
+from ..tables import precompute
+from .canvas import new_figure as _new_figure, save_png as _save_atomic
 
 __all__ = ["make_squeeze_figures", "copper_surface", "COPPER"]
 
@@ -44,12 +48,10 @@ THEORY_LABEL = {"average": "1: average separation", "critical_junction": "2: cri
 
 
 def copper_surface():
-    from fastcontact import SelfAffinePSD
     return SelfAffinePSD(**COPPER)
 
 
 def _histories(tables, t):
-    from fastcontact.squeeze import squeeze_history
     out = {}
     for p0 in PRESSURES:
         for th in ("average", "critical_junction"):
@@ -152,7 +154,6 @@ def make_squeeze_figures(outdir, tables=None) -> list[Path]:
     ``tables``: optional precomputed tables of :func:`copper_surface` holding "average",
     "critical_junction" and "emt" (built here otherwise, ~10 s).
     """
-    from fastcontact.tables import precompute
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     if tables is None:

@@ -22,6 +22,7 @@ import math
 import sys
 from pathlib import Path
 
+import matplotlib
 import matplotlib.ticker
 import numpy as np
 
@@ -83,7 +84,6 @@ def _curve_colors(n):
     """Distinct colours for up to len(COLORS) curves, else a viridis ramp."""
     if n <= len(COLORS):
         return list(COLORS[:n])
-    import matplotlib
     cmap = matplotlib.colormaps["viridis"]
     return [cmap(x) for x in np.linspace(0.0, 0.9, n)]
 

@@ -35,7 +35,7 @@ PAPER_REFERENCE = reference_list(["lorenz_persson_2010_squeeze"])[0]
 #: figures are drawn only for studies of at most this many rows (all surfaces)
 FIGURE_MAX_ROWS = 200_000
 #: results are returned in memory (``RunResult.results``) up to this many rows
-KEEP_MAX_ROWS = 1_000_000
+KEEP_MAX_ROWS = 200_000
 
 
 @dataclasses.dataclass
