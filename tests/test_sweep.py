@@ -209,3 +209,114 @@ def test_broken_surface_gets_error_rows_and_external_scheduler(setup, tmp_path):
     assert (g.error == "").all() and np.isfinite(g.t_star).all()
     # partitions share one schema: the folder reads as one dataset
     assert len(pd.read_parquet(tmp_path / "o" / "data")) == 2 * N_CASES
+
+
+# ============================================================== issue 15.6: signals and lock
+def _wait_for_partitions(proc, out, n, timeout=240):
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        k = len(list((out / "data").glob("part-*.parquet"))) if (out / "data").exists() else 0
+        if k >= n or proc.poll() is not None:
+            return k
+        time.sleep(0.02)
+    return -1
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
+                         ids=["SIGINT", "SIGTERM"])
+def test_signal_ends_sweep_cleanly_and_resume_is_exact(setup, tmp_path, sig, code):
+    """A real signal delivered to the CLI process (not its workers): one line on stderr, exit
+    130 / 143, manifest "interrupted", lock released; the rerun completes exactly."""
+    base, db, scene, clean, man = setup
+    out = tmp_path / "sig"
+    cmd = [sys.executable, "-m", "fastcontact.cli", "sweep", str(db), "-o", str(out),
+           "--scene", str(scene), "--workers", "1", "--no-progress"]
+    proc = subprocess.Popen(cmd, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            start_new_session=True)
+    try:
+        k = _wait_for_partitions(proc, out, 2)
+        assert proc.poll() is None and 0 < k < 14, f"{k} partitions"
+        proc.send_signal(sig)
+        stdout, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=60)
+    err = stderr.decode().strip()
+    assert proc.returncode == code, err[-3000:]
+    last = err.splitlines()[-1]
+    assert last.startswith(f"fastcontact: sweep interrupted by {signal.Signals(sig).name}")
+    assert "Traceback" not in err
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["status"] == "interrupted"
+    assert not (out / ".sweep.lock").exists()
+    listed = set(manifest["partitions"])
+    on_disk = {p.name for p in (out / "data").glob("part-*.parquet")}
+    assert {manifest["partitions"][s]["file"] for s in listed} <= on_disk
+    r = subprocess.run(cmd, env=_env(), capture_output=True, timeout=600)
+    assert r.returncode == 0, r.stderr.decode()[-3000:]
+    got = read_sweep(out)
+    assert not got.duplicated(["surface_id", "case_id"]).any()
+    pd.testing.assert_frame_equal(got, read_sweep(clean))
+
+
+def test_second_sweep_on_same_folder_refused(setup, tmp_path):
+    """A live lock (this process) refuses; a lock of a dead pid on this host is taken over."""
+    import socket
+    from fastcontact.studies.sweep import LOCK_NAME
+    base, db, scene, clean, man = setup
+    out = tmp_path / "locked"
+    out.mkdir()
+    lock = out / LOCK_NAME
+    lock.write_text(json.dumps({"pid": os.getpid(), "host": socket.gethostname(),
+                                "since": "2026-01-01T00:00:00+00:00", "heartbeat": time.time()}))
+    with pytest.raises(SweepError, match=r"is in use by another sweep \(pid \d+ on .*wait for "
+                                         r"it to finish or use another -o"):
+        run_sweep(db, out, scene, workers=1, progress=False)
+    assert lock.exists() and not (out / "manifest.json").exists()
+    # a dead process: a child that has exited
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True).stdout.strip()
+    lock.write_text(json.dumps({"pid": int(dead), "host": socket.gethostname(),
+                                "since": "2026-01-01T00:00:00+00:00", "heartbeat": 0.0}))
+    notes = []
+    import shutil
+    shutil.copytree(clean / "data", out / "data")
+    shutil.copy(clean / "manifest.json", out / "manifest.json")
+    m = run_sweep(db, out, scene, workers=1, progress=False, log=notes.append)
+    assert m["status"] == "complete" and m["computed_this_run"] == 0
+    assert any("stale lock" in n for n in notes)
+    assert not lock.exists()
+    # another host: stale only without a recent heartbeat
+    lock.write_text(json.dumps({"pid": 1, "host": "elsewhere", "since": "x",
+                                "heartbeat": time.time()}))
+    with pytest.raises(SweepError, match="in use by another sweep"):
+        run_sweep(db, out, scene, workers=1, progress=False)
+    lock.write_text(json.dumps({"pid": 1, "host": "elsewhere", "since": "x", "heartbeat": 0.0}))
+    assert run_sweep(db, out, scene, workers=1, progress=False)["status"] == "complete"
+
+
+def test_local_cluster_workers_are_fork_safe_and_not_oversubscribed():
+    """The fixture-style cluster: spawned workers, 1 Dask thread each, numba's workqueue
+    layer and cores // workers numba threads (checked inside the workers)."""
+    from distributed import Client
+    from fastcontact.studies.sweep import local_cluster
+
+    def probe():
+        import multiprocessing
+        import numba
+        return (os.environ.get("NUMBA_THREADING_LAYER"), numba.config.NUMBA_NUM_THREADS,
+                multiprocessing.current_process().name, os.environ.get("OMP_NUM_THREADS"))
+
+    cluster, info = local_cluster(2)
+    try:
+        with Client(cluster) as client:
+            got = client.run(probe)
+            threads = client.nthreads()
+    finally:
+        cluster.close()
+    cores = os.cpu_count() or 1
+    assert set(threads.values()) == {1}
+    for layer, nthreads, _, omp in got.values():
+        assert layer == "workqueue" and nthreads == max(1, cores // 2) and omp == "1"
+    assert info["numba_threads_per_worker"] == max(1, cores // 2)

@@ -2,53 +2,79 @@
 
 ``fastcontact sweep DB -o OUT --scene S.toml [--scheduler ADDR] [--workers N]``
 
-Per surface (one Dask task each): build the surface's tables with only the theories the scene
-needs (or reuse them from ``--cache-dir``), evaluate every case of the scene, and write the
-rows as one Parquet partition ``OUT/data/part-<surface>.parquet`` — to a temporary name in the
-same folder, then ``os.replace`` (atomic: a partition is either complete or absent). The
-driver keeps ``OUT/manifest.json`` (atomic rewrites) with the sweep's identity and the
-completed partitions.
+One Dask task per surface builds the surface's tables (only the theories the scene needs, or
+from ``cache_dir``), evaluates every case and writes ``OUT/data/part-<surface>.parquet``
+atomically (complete or absent). The driver keeps ``OUT/manifest.json`` (atomic rewrites;
+``status`` is "running", "complete", "incomplete" or "interrupted") and holds the lock
+``OUT/.sweep.lock`` while it runs.
 
-Resuming: rerunning the same command skips every partition that exists, reads back, belongs
-to this sweep (same scene, database content and table options: ``sweep_key`` in its metadata)
-and has one row per case; everything else is (re)computed. Since partitions are written whole
-and atomically, an interrupted sweep (even SIGKILL) neither loses nor duplicates a row. An
-output folder holding a *different* sweep is refused.
-
-Cluster: by default a ``distributed.LocalCluster`` of worker processes (started with the
-'spawn' method, never forked) with ``threads_per_worker=1`` — the numba kernels hold the GIL,
-so a second Dask thread would add no throughput, and numba's ``workqueue`` layer aborts when
-two threads enter parallel kernels at once — and the cores left to each worker given to
-numba: ``NUMBA_NUM_THREADS`` = cores // workers. ``NUMBA_THREADING_LAYER=workqueue`` (the
-default OpenMP layer is not fork-safe), ``OMP/MKL/OPENBLAS_NUM_THREADS=1``. With
-``--scheduler ADDR`` an existing cluster is used; its workers' environment and thread count
-are theirs to set (use 1 thread per worker, or the 'tbb'/'omp' layer with spawned workers).
-
-Read the results with :func:`read_sweep` (or ``pandas.read_parquet(OUT / "data")``).
+* **Resume**: rerunning the same command keeps every partition that reads back, belongs to
+  this sweep (``sweep_key``: scene, database content, table options, version) and has one
+  row per case; the rest is computed. No row is lost or duplicated, even after SIGKILL.
+* **Interrupts**: SIGINT / SIGTERM stop the cluster, mark the manifest "interrupted" and
+  raise :class:`SweepInterrupted` (exit code 130 / 143 from the CLI, one line).
+* **One sweep per folder**: a second sweep on a folder whose lock is held by a live process
+  is refused; the lock of a dead process (same host: pid gone; other host: no heartbeat for
+  :data:`LOCK_STALE_SECONDS`) is taken over.
+* **Cluster**: a ``distributed.LocalCluster`` of *spawned* worker processes (never forked),
+  one thread each (numba kernels hold the GIL; the 'workqueue' threading layer must not be
+  entered by two threads at once), the cores left to each worker given to numba
+  (``NUMBA_NUM_THREADS`` = cores // workers, ``NUMBA_THREADING_LAYER=workqueue``,
+  OMP/MKL/OpenBLAS at 1 thread). With ``scheduler=`` an existing cluster is used as is.
 """
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import hashlib
 import json
 import logging
-import math
 import os
 import re
-import sys
+import signal
+import socket
+import threading
 import time
 from pathlib import Path
 
+import pandas as pd
+import pyarrow.parquet as pq
+from tqdm import tqdm
 
-__all__ = ["run_sweep", "read_sweep", "sweep_key", "worker_environment", "SweepError"]
+from .. import __version__
+from .._core.vocab import METADATA_KEY
+from ..surface.psd import TabulatedPSD
+from ..surface.roaddb import open_road_database
+from ..tables.cache import obtain_tables
+from .evaluate import empty_results, evaluate_cases
+from .load import load_scene
+from .output import write_json_atomic, write_parquet_atomic
+from .scene import Scene, SurfaceSpec
+
+__all__ = ["run_sweep", "read_sweep", "sweep_key", "worker_environment", "local_cluster",
+           "SweepError", "SweepInterrupted", "LOCK_NAME", "LOCK_STALE_SECONDS"]
 
 DATA_DIR = "data"
 MANIFEST = "manifest.json"
-META_KEY = b"fastcontact"
+META_KEY = METADATA_KEY
+#: lock file of a running sweep, inside the output folder
+LOCK_NAME = ".sweep.lock"
+#: a lock from another host whose heartbeat is older than this [s] is stale
+LOCK_STALE_SECONDS = 120.0
+_HEARTBEAT_SECONDS = 5.0
+_EXIT_CODES = {signal.SIGINT: 130, signal.SIGTERM: 143}
 
 
 class SweepError(ValueError):
-    """Bad sweep input (the CLI reports it in one line, exit code 2)."""
+    """Bad sweep input or an output folder in use (the CLI reports it in one line, exit 2)."""
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """SIGINT / SIGTERM ended a sweep; ``exit_code`` is 130 / 143 and ``str()`` one line."""
+
+    def __init__(self, message, exit_code):
+        super().__init__(message)
+        self.exit_code = exit_code
 
 
 def worker_environment(threads_per_worker=1):
@@ -70,23 +96,22 @@ def partition_path(outdir, sid):
 
 def sweep_key(scene, db_fingerprint):
     """Identity of a sweep: scene text, database content, table options, version."""
-    from .. import __version__
     blob = json.dumps({"scene": scene.sha256, "db": db_fingerprint,
                        "options": scene.table_options, "theories": list(scene.theories),
                        "version": __version__}, sort_keys=True).encode()
     return hashlib.sha256(blob).hexdigest()
 
 
+def _utc_now():
+    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
 # ============================================================================ the task
 def _surface_task(sid, q, C, scene, outpath, key, cache_dir):
     """Build tables for one surface, evaluate all cases, write the partition atomically."""
-    import pandas as pd
-    from ..surface.psd import TabulatedPSD
-    from .scene import (SurfaceSpec, empty_results, evaluate_cases, obtain_tables,
-                        write_parquet_atomic)
     t0 = time.perf_counter()
     cases = scene.cases()
-    note, table_meta, t_tab = None, {}, math.nan
+    note, table_meta, t_tab = None, {}, float("nan")
     try:
         psd = TabulatedPSD(q, C, convention="persson")
         spec = SurfaceSpec(sid, "inline", psd_obj=psd)
@@ -102,6 +127,7 @@ def _surface_task(sid, q, C, scene, outpath, key, cache_dir):
         res = empty_results(scene.columns, len(cases), exclude=cases.columns)
         res["error"] = note
     df = pd.concat([pd.DataFrame({"surface_id": sid}, index=cases.index), cases, res], axis=1)
+    df.attrs = dict(res.attrs)
     n_err = int((df["error"] != "").sum())
     meta = {"sweep_key": key, "surface_id": sid, "rows": len(df), "table": table_meta,
             "note": note, "error_rows": n_err, "table_seconds": t_tab,
@@ -112,9 +138,7 @@ def _surface_task(sid, q, C, scene, outpath, key, cache_dir):
             "file": Path(outpath).name}
 
 
-# ============================================================================ driver
 def _read_partition_meta(path):
-    import pyarrow.parquet as pq
     try:
         pf = pq.ParquetFile(path)
         raw = (pf.schema_arrow.metadata or {}).get(META_KEY)
@@ -126,93 +150,145 @@ def _read_partition_meta(path):
         return None
 
 
-def _atomic_json(path, obj):
-    from .scene import _atomic_write_bytes, _json_default
-    _atomic_write_bytes(Path(path), json.dumps(obj, indent=1, sort_keys=True,
-                                               default=_json_default).encode())
+# ============================================================================ the lock
+def _process_start(pid):
+    """Start time of process ``pid`` (clock ticks since boot, Linux), or None if unknown."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return int(fh.read().rsplit(b")", 1)[1].split()[19])
+    except (OSError, ValueError, IndexError):
+        return None
 
 
-class _Progress:
-    def __init__(self, total, done0, cases, enabled, stream=None):
-        self.total, self.done, self.cases = total, done0, cases
-        self.enabled = enabled
-        self.stream = stream or sys.stderr
-        self.t0 = time.perf_counter()
-        self.n0 = done0
-        self.last = 0.0
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+def _alive(info):
+    """Whether the process that wrote lock ``info`` may still run."""
+    if info.get("host") != socket.gethostname():
+        return time.time() - float(info.get("heartbeat", 0.0)) < LOCK_STALE_SECONDS
+    pid = int(info.get("pid", -1))
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    start = _process_start(pid)
+    return info.get("start") is None or start is None or start == info.get("start")
 
-    def update(self, force=False):
-        if not self.enabled:
-            return
-        now = time.perf_counter()
-        if not force and now - self.last < (0.5 if self.tty else 5.0):
-            return
-        self.last = now
-        dt = now - self.t0
-        new = self.done - self.n0
-        rate = new / dt if dt > 0 else 0.0
-        left = self.total - self.done
-        eta = f"{left / rate:.0f} s" if rate > 0 else "?"
-        msg = (f"sweep: {self.done}/{self.total} surfaces ({self.done * self.cases} cases) done, "
-               f"{rate:.2f} surfaces/s, {rate * self.cases:.0f} cases/s, ETA {eta}")
-        if self.tty:
-            self.stream.write("\r" + msg + " " * 4)
+
+class _Lock:
+    """``OUT/.sweep.lock``: created exclusively, heartbeat every few seconds, removed on exit;
+    a stale lock (dead owner) is taken over."""
+
+    def __init__(self, outdir, log):
+        self.path = Path(outdir) / LOCK_NAME
+        self.log = log
+        self._stop = threading.Event()
+        self._thread = None
+        self.info = {"pid": os.getpid(), "host": socket.gethostname(),
+                     "start": _process_start(os.getpid()), "since": _utc_now()}
+
+    def _write_new(self):
+        self.info["heartbeat"] = time.time()
+        fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        with os.fdopen(fd, "w") as fh:
+            json.dump(self.info, fh)
+
+    def acquire(self):
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        for _ in range(3):
+            try:
+                self._write_new()
+                break
+            except FileExistsError:
+                try:
+                    other = json.loads(self.path.read_text() or "{}")
+                except (OSError, ValueError):
+                    other = {}
+                if other and _alive(other):
+                    raise SweepError(
+                        f"output folder {str(self.path.parent)!r} is in use by another sweep "
+                        f"(pid {other.get('pid')} on {other.get('host')} since "
+                        f"{other.get('since')}; lock {self.path.name}): wait for it to finish "
+                        f"or use another -o") from None
+                stale = self.path.with_name(f"{LOCK_NAME}.stale.{os.getpid()}")
+                with contextlib.suppress(FileNotFoundError):
+                    os.replace(self.path, stale)
+                    stale.unlink()
+                self.log(f"note: took over the stale lock of a dead sweep (pid "
+                         f"{other.get('pid')} on {other.get('host')})")
         else:
-            self.stream.write(msg + "\n")
-        self.stream.flush()
+            raise SweepError(f"output folder {str(self.path.parent)!r}: cannot take the lock "
+                             f"{self.path.name} (another sweep is starting there)")
+        self._thread = threading.Thread(target=self._beat, daemon=True)
+        self._thread.start()
+        return self
 
-    def finish(self):
-        if self.enabled:
-            self.update(force=True)
-            if self.tty:
-                self.stream.write("\n")
-            self.stream.flush()
+    def _beat(self):
+        while not self._stop.wait(_HEARTBEAT_SECONDS):
+            self.info["heartbeat"] = time.time()
+            with contextlib.suppress(OSError):
+                tmp = self.path.with_name(f"{LOCK_NAME}.{os.getpid()}.tmp")
+                tmp.write_text(json.dumps(self.info))
+                os.replace(tmp, self.path)
+
+    def release(self):
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+        with contextlib.suppress(OSError, ValueError):
+            if json.loads(self.path.read_text()).get("pid") == os.getpid():
+                self.path.unlink()
 
 
-def _start_cluster(workers, scheduler):
+# ============================================================================ signals
+@contextlib.contextmanager
+def _interrupts():
+    """SIGINT / SIGTERM raise :class:`SweepInterrupted` in the main thread while inside."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum, frame):
+        name = signal.Signals(signum).name
+        raise SweepInterrupted(name, _EXIT_CODES[signum])
+
+    old = {s: signal.signal(s, handler) for s in _EXIT_CODES}
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
+# ============================================================================ cluster
+def local_cluster(workers=None):
+    """A ``distributed.LocalCluster`` set up for fastcontact's numba kernels.
+
+    Spawned worker processes (never forked: numba's threading layers are not fork-safe),
+    one Dask thread each, ``worker_environment(cores // workers)``.
+
+    Returns
+    -------
+    (cluster, info)
+        ``info`` records workers, threads and the environment (kept in the manifest).
+    """
     import dask
-    from distributed import Client, LocalCluster
-    if scheduler:
-        return Client(scheduler, timeout="30s"), None, {"scheduler": scheduler}
+    from distributed import LocalCluster
     cores = os.cpu_count() or 1
     n = int(workers) if workers else cores
-    # one task at a time per worker process: numba kernels hold the GIL (more Dask threads
-    # would not add throughput) and the workqueue layer must not be entered by two threads
-    # at once; the cores a worker has to itself go to numba's parallel kernels instead
     numba_threads = max(1, cores // n)
     env = worker_environment(numba_threads)
     with dask.config.set({"distributed.worker.multiprocessing-method": "spawn",
                           "distributed.worker.daemon": False}):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                dashboard_address=None, env=env, silence_logs=logging.ERROR)
-    client = Client(cluster)
-    return client, cluster, {"local_workers": n, "threads_per_worker": 1,
-                             "numba_threads_per_worker": numba_threads, "env": env}
+    return cluster, {"local_workers": n, "threads_per_worker": 1,
+                     "numba_threads_per_worker": numba_threads, "env": env}
 
 
-def run_sweep(db, outdir, scene, *, scheduler=None, workers=None, convention=None,
-              cache_dir=None, progress=True, log=None):
-    """Evaluate ``scene``'s cases on every surface of the road database ``db``.
-
-    Parameters
-    ----------
-    db : path of the road database (see :mod:`fastcontact.roaddb`)
-    outdir : output folder (``data/part-*.parquet`` + ``manifest.json``)
-    scene : path of a scene TOML (or a loaded Scene); its [surfaces] are not used
-    scheduler : address of an existing Dask scheduler (default: start a LocalCluster)
-    workers : number of local worker processes (default: cores)
-    convention : C convention for database files that do not record one
-    cache_dir : reuse/keep tables there (default: none, tables are built in the workers)
-    progress : print a progress line to stderr
-
-    Returns the manifest dict. Raises SceneError / SweepError on bad input (before any file is
-    written).
-    """
-    from .. import __version__
-    from ..surface.roaddb import open_road_database
-    from .scene import Scene, load_scene
-    log = log or (lambda m: None)
+# ============================================================================ driver steps
+def _open_inputs(db, scene, convention, workers, log):
+    """(Scene, ids, spectra, fingerprint) or SweepError/SceneError before any file is written."""
     sc = scene if isinstance(scene, Scene) else load_scene(scene, for_sweep=True)
     if sc.surfaces:
         log(f"note: the scene's [surfaces] ({', '.join(sc.surfaces)}) are not used by a sweep; "
@@ -230,12 +306,15 @@ def run_sweep(db, outdir, scene, *, scheduler=None, workers=None, convention=Non
         raise SweepError(str(exc)) from None
     names = {}
     for sid in ids:
-        nm = partition_path(outdir, sid).name
+        nm = partition_path(".", sid).name
         if nm in names:
             raise SweepError(f"surface ids {names[nm]!r} and {sid!r} map to the same partition file")
         names[nm] = sid
-    key = sweep_key(sc, fingerprint)
-    outdir = Path(outdir)
+    return sc, ids, spectra, fingerprint
+
+
+def _check_outdir(outdir, key):
+    """Refuse a folder that holds something else, or a different sweep."""
     mpath = outdir / MANIFEST
     if mpath.exists():
         try:
@@ -245,17 +324,18 @@ def run_sweep(db, outdir, scene, *, scheduler=None, workers=None, convention=Non
         if old.get("sweep_key") not in (None, key):
             raise SweepError(f"output folder {str(outdir)!r} holds a different sweep (scene, "
                              f"database or options changed): use another -o")
-    elif outdir.exists() and any(outdir.iterdir()):
+    elif outdir.exists() and any(p.name != LOCK_NAME for p in outdir.iterdir()):
         raise SweepError(f"output folder {str(outdir)!r} exists, is not empty and holds no "
                          f"sweep manifest: use another -o")
-    cases = sc.cases()
-    n_cases = len(cases)
-    (outdir / DATA_DIR).mkdir(parents=True, exist_ok=True)
-    for tmp in (outdir / DATA_DIR).glob(".*.tmp"):   # leftovers of an interrupted writer
-        try:
+
+
+def _completed(outdir, ids, key, n_cases):
+    """Partitions already complete (validated), after removing leftovers and strays."""
+    data = outdir / DATA_DIR
+    data.mkdir(parents=True, exist_ok=True)
+    for tmp in data.glob(".*.tmp"):                  # leftovers of an interrupted writer
+        with contextlib.suppress(OSError):
             tmp.unlink()
-        except OSError:
-            pass
     done = {}
     for sid in ids:
         p = partition_path(outdir, sid)
@@ -268,72 +348,166 @@ def run_sweep(db, outdir, scene, *, scheduler=None, workers=None, convention=Non
                              "error_rows": meta.get("error_rows", 0)}
             else:
                 p.unlink()
+    return done
+
+
+def _compute(todo, spectra, sc, outdir, key, cache_dir, client, manifest, done, bar, mpath):
+    """Submit one task per surface and record them as they complete."""
+    from distributed import as_completed
+    cdir = str(Path(cache_dir).resolve()) if cache_dir else None
+    futs = {}
+    for sid in todo:
+        q, C = spectra[sid]
+        # the scene (a few kB) travels with each task; nothing is scattered, so a lost worker
+        # loses no shared data
+        f = client.submit(_surface_task, sid, q, C, sc, str(partition_path(outdir, sid).resolve()),
+                          key, cdir, key=f"surface-{key[:8]}-{_safe_name(sid)}", pure=False)
+        futs[f] = sid
+    last_write = time.perf_counter()
+    for fut in as_completed(list(futs)):
+        sid = futs[fut]
+        try:
+            done[sid] = fut.result()
+        except Exception as exc:  # noqa: BLE001 - a task crashed: record, go on
+            manifest["failed"][sid] = f"{type(exc).__name__}: {exc}"
+        bar.update(1)
+        if time.perf_counter() - last_write > 2.0:
+            write_json_atomic(mpath, manifest)
+            last_write = time.perf_counter()
+
+
+def _finish(manifest, done, ids, todo, t0, status=None):
+    manifest["partitions"] = done
+    manifest["seconds_this_run"] = round(time.perf_counter() - t0, 3)
+    manifest["computed_this_run"] = max(0, len(done) - manifest["resumed_with_completed"])
+    manifest["status"] = status or ("complete" if len(done) == len(ids) else "incomplete")
+    manifest["rows"] = int(sum(d["rows"] for d in done.values()))
+    manifest["surfaces_with_error_rows"] = sorted(s for s, d in done.items() if d.get("error_rows"))
+    manifest["surfaces_with_notes"] = sorted(s for s, d in done.items() if d.get("note"))
+    manifest["finished_utc"] = _utc_now()
+    return manifest
+
+
+def run_sweep(db, outdir, scene, *, scheduler=None, workers=None, convention=None,
+              cache_dir=None, progress=True, log=None):
+    """Evaluate ``scene``'s cases on every surface of the road database ``db``.
+
+    Parameters
+    ----------
+    db : path-like
+        Road database (see :mod:`fastcontact.surface.roaddb`).
+    outdir : path-like
+        Output folder (``data/part-*.parquet``, ``manifest.json``, the lock while running).
+    scene : path-like or Scene
+        Scene TOML (or a loaded Scene); its [surfaces] are not used.
+    scheduler : str, optional
+        Address of an existing Dask scheduler (default: start :func:`local_cluster`).
+    workers : int, optional
+        Local worker processes (default: cores).
+    convention : str, optional
+        C convention for database files that do not record one.
+    cache_dir : path-like, optional
+        Reuse / keep tables there (default: tables are built in the workers).
+    progress : bool
+        Show a progress bar (tqdm) on stderr.
+    log : callable, optional
+        Receives one-line notes.
+
+    Returns
+    -------
+    dict
+        The manifest.
+
+    Raises
+    ------
+    SweepError, SceneError
+        Bad input or a folder in use — before any file is written.
+    SweepInterrupted
+        SIGINT / SIGTERM (the manifest then says "interrupted"; rerun to resume).
+    """
+    log = log or (lambda m: None)
+    sc, ids, spectra, fingerprint = _open_inputs(db, scene, convention, workers, log)
+    key = sweep_key(sc, fingerprint)
+    outdir = Path(outdir)
+    _check_outdir(outdir, key)
+    lock = _Lock(outdir, log).acquire()
+    try:
+        with _interrupts():
+            return _run_locked(db, outdir, sc, ids, spectra, fingerprint, key, scheduler,
+                               workers, cache_dir, progress, log)
+    finally:
+        lock.release()
+
+
+def _run_locked(db, outdir, sc, ids, spectra, fingerprint, key, scheduler, workers, cache_dir,
+                progress, log):
+    n_cases = len(sc.cases())
+    _check_outdir(outdir, key)                      # again, now that the folder is ours
+    done = _completed(outdir, ids, key, n_cases)
     todo = [sid for sid in ids if sid not in done]
+    mpath = outdir / MANIFEST
     manifest = {
         "sweep_key": key, "fastcontact_version": __version__, "scene": sc.source,
         "scene_sha256": sc.sha256, "scene_toml": sc.text, "study": sc.kind,
         "theories": list(sc.theories), "table_options": sc.table_options,
         "columns": sc.columns, "database": str(Path(db).resolve()),
         "database_fingerprint": fingerprint, "n_surfaces": len(ids),
-        "cases_per_surface": n_cases, "status": "running",
-        "started_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "cases_per_surface": n_cases, "status": "running", "started_utc": _utc_now(),
         "resumed_with_completed": len(done), "partitions": done, "failed": {},
     }
-    _atomic_json(mpath, manifest)
+    write_json_atomic(mpath, manifest)
     log(f"sweep: {len(ids)} surfaces x {n_cases} cases; {len(done)} partitions already complete, "
         f"{len(todo)} to compute")
-    prog = _Progress(len(ids), len(done), n_cases, progress)
     t0 = time.perf_counter()
-    cluster_info = {}
-    if todo:
-        from distributed import as_completed
-        client, cluster, cluster_info = _start_cluster(workers, scheduler)
-        manifest["cluster"] = cluster_info
-        try:
-            # the scene (a few kB) travels with each task; the cases are rebuilt from it there
-            # (nothing is scattered, so a lost worker loses no shared data)
-            cdir = str(Path(cache_dir).resolve()) if cache_dir else None
-            futs = {}
-            for sid in todo:
-                q, C = spectra[sid]
-                f = client.submit(_surface_task, sid, q, C, sc,
-                                  str(partition_path(outdir, sid).resolve()), key, cdir,
-                                  key=f"surface-{key[:8]}-{_safe_name(sid)}", pure=False)
-                futs[f] = sid
-            last_write = time.perf_counter()
-            for fut in as_completed(list(futs)):
-                sid = futs[fut]
-                try:
-                    info = fut.result()
-                    done[sid] = info
-                except Exception as exc:  # noqa: BLE001 - a task crashed: record, go on
-                    manifest["failed"][sid] = f"{type(exc).__name__}: {exc}"
-                prog.done = len(done)
-                prog.update()
-                if time.perf_counter() - last_write > 2.0:
-                    _atomic_json(mpath, manifest)
-                    last_write = time.perf_counter()
-        finally:
-            client.close()
+    client = cluster = None
+    bar = tqdm(total=len(ids), initial=len(done), unit="surface", disable=not progress,
+               desc="sweep", dynamic_ncols=True, leave=False)
+    try:
+        if todo:
+            from distributed import Client
+            if scheduler:
+                client, info = Client(scheduler, timeout="30s"), {"scheduler": scheduler}
+            else:
+                cluster, info = local_cluster(workers)
+                client = Client(cluster)
+            manifest["cluster"] = info
+            _compute(todo, spectra, sc, outdir, key, cache_dir, client, manifest, done, bar,
+                     mpath)
+    except SweepInterrupted as exc:
+        _finish(manifest, done, ids, todo, t0, status="interrupted")
+        manifest["interrupted_by"] = str(exc)
+        write_json_atomic(mpath, manifest)
+        raise SweepInterrupted(
+            f"sweep interrupted by {exc}: {len(done)}/{len(ids)} surfaces complete in "
+            f"{outdir}; rerun the same command to resume", exc.exit_code) from None
+    finally:
+        bar.close()
+        with contextlib.suppress(Exception), _ignore_signals():
+            if client is not None:
+                client.close()
             if cluster is not None:
                 cluster.close()
-    prog.finish()
-    manifest["partitions"] = done
-    manifest["seconds_this_run"] = round(time.perf_counter() - t0, 3)
-    manifest["computed_this_run"] = len(todo) - len(manifest["failed"])
-    manifest["status"] = "complete" if len(done) == len(ids) else "incomplete"
-    manifest["rows"] = int(sum(d["rows"] for d in done.values()))
-    manifest["surfaces_with_error_rows"] = sorted(sid for sid, d in done.items()
-                                                  if d.get("error_rows"))
-    manifest["surfaces_with_notes"] = sorted(sid for sid, d in done.items() if d.get("note"))
-    manifest["finished_utc"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
-    _atomic_json(mpath, manifest)
+    _finish(manifest, done, ids, todo, t0)
+    write_json_atomic(mpath, manifest)
     return manifest
+
+
+@contextlib.contextmanager
+def _ignore_signals():
+    """A second Ctrl-C while the cluster shuts down must not leave it half-closed."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = {s: signal.signal(s, signal.SIG_IGN) for s in _EXIT_CODES}
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
 
 
 def read_sweep(outdir):
     """All rows of a sweep as one DataFrame (sorted by surface_id, case_id)."""
-    import pandas as pd
     d = Path(outdir) / DATA_DIR
     files = sorted(p for p in d.glob("part-*.parquet"))
     if not files:

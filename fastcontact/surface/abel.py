@@ -39,7 +39,7 @@ def _local_slopes(q, v, half_width_decades=0.25):
 
 
 def _powerlaw_factor(H):
-    """Γ(1+H)/(√π Γ(H+½)): C = factor · C1D/q for C1D ∝ q^{-(1+2H)} (SPEC §1)."""
+    """Γ(1+H)/(√π Γ(H+½)): C = factor · C1D/q for C1D ∝ q^{-(1+2H)} (power-law limit of :func:`abel_invert`)."""
     return np.exp(gammaln(1.0 + H) - gammaln(H + 0.5)) / math.sqrt(math.pi)
 
 

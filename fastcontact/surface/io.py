@@ -25,11 +25,13 @@ from .._core.vocab import CONVENTIONS
 from .abel import abel_fit
 from .psd import PSD, TabulatedPSD
 
-__all__ = ["read_psd", "write_psd", "psd_from_surface_topography", "CONVENTION_KEY",
-           "CE_2D_SERIES"]
+__all__ = ["read_psd", "write_psd", "read_topography", "psd_from_surface_topography",
+           "CONVENTION_KEY", "CE_2D_SERIES", "TOPOGRAPHY_EXTRA"]
 
 #: Parquet key-value metadata key holding the convention of the stored C column
 CONVENTION_KEY = b"fastcontact.convention"
+#: how to install the optional SurfaceTopography reader
+TOPOGRAPHY_EXTRA = 'pip install "fastcontact[topography]"'
 #: name of contact.engineering's isotropic 2-D series (values q C_ST / π [m³])
 CE_2D_SERIES = "q/π × 2D PSD"
 _SUFFIXES = {".csv": "csv", ".csv.gz": "csv.gz", ".txt": "txt", ".dat": "txt",
@@ -330,6 +332,39 @@ def read_psd(path, convention=None, *, q_col=None, C_col=None, series=None, subj
 
 
 # ============================================================================ SurfaceTopography
+def read_topography(path, *, unit=None, **kwargs):
+    """A measured topography file (AFM, optical profilometer, stylus, ...) as a
+    SurfaceTopography container, ready for :func:`~fastcontact.surface.topography.psd_from_heights`.
+
+    Parameters
+    ----------
+    path : str or Path
+        Any format SurfaceTopography reads (``.nc``, ``.sur``, ``.ibw``, ``.opd``, ``.x3p``,
+        ``.txt`` height matrices, ...).
+    unit : str, optional
+        Length unit of the file when it states none (e.g. ``"um"``).
+    **kwargs
+        Passed to ``SurfaceTopography.read_topography`` (e.g. ``physical_sizes``,
+        ``periodic``, ``channel_index``).
+
+    Raises
+    ------
+    ImportError
+        One line naming the optional extra when SurfaceTopography is not installed.
+    """
+    try:
+        import SurfaceTopography
+    except ImportError:
+        raise ImportError(f"reading topography files needs SurfaceTopography: "
+                          f"{TOPOGRAPHY_EXTRA}") from None
+    if unit is not None:
+        kwargs["unit"] = unit
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise ValueError(f"path = {path!r} is invalid: no such file")
+    return SurfaceTopography.read_topography(path, **kwargs)
+
+
 def psd_from_surface_topography(q, C, *, dim, unit="m"):
     """A PSD computed by SurfaceTopography, as a Persson-convention :class:`TabulatedPSD`.
 

@@ -26,10 +26,10 @@ from .._core.validate import as_float_array, check_choice, check_int, check_posi
 from ._binning import (BINS_PER_DECADE, _bin_edges, _default_n_bins, _equal_area_edges,
                        _histopolate, _tile_bins, _trim_roundoff)
 from .abel import abel_fit, abel_forward, abel_invert
-from .io import CONVENTION_KEY, read_psd, write_psd
+from .io import CONVENTION_KEY, read_psd, read_topography, write_psd
 from .psd import PSD, TabulatedPSD
 
-__all__ = ["psd_from_heights", "line_psd", "line_scans", "read_psd", "write_psd",
+__all__ = ["psd_from_heights", "line_psd", "line_scans", "read_psd", "write_psd", "read_topography",
            "synthetic_heights", "abel_forward", "abel_invert", "abel_fit",
            "CONVENTION_KEY", "BINS_PER_DECADE", "LENGTH_UNITS"]
 
@@ -348,6 +348,17 @@ def _inputs(heights, spacing, periodic, pair):
     return heights, (spacing, spacing) if pair else spacing, bool(periodic), "array [m]"
 
 
+def _check_parseval(psd, h2):
+    """RuntimeWarning when a map's spectrum misses more than PARSEVAL_WARN of its h_rms."""
+    dev = psd.h_rms / math.sqrt(h2) - 1.0
+    if abs(dev) > PARSEVAL_WARN:
+        warnings.warn(
+            f"psd_from_heights: the spectrum's h_rms = {psd.h_rms:.4g} m differs from the "
+            f"heights' rms {math.sqrt(h2):.4g} m by {100 * dev:+.2f} %: the map does not "
+            f"resolve its longest wavelengths (roll-off below ~10·2π/L) or has roughness "
+            f"beyond the Nyquist wavevector π/a (FFT corners)", RuntimeWarning, stacklevel=3)
+
+
 # ============================================================================ public API
 def psd_from_heights(heights, spacing=None, *, n_bins=None, window="auto", periodic=None,
                      line_scans=False, detrend="mean"):
@@ -427,13 +438,7 @@ def psd_from_heights(heights, spacing=None, *, n_bins=None, window="auto", perio
         psd = TabulatedPSD(q, abel_fit(q, d, w), convention="persson")
     else:
         psd, h2 = _map_psd(h, spacing, n_bins, win, detrend)
-        dev = psd.h_rms / math.sqrt(h2) - 1.0
-        if abs(dev) > PARSEVAL_WARN:
-            warnings.warn(
-                f"psd_from_heights: the spectrum's h_rms = {psd.h_rms:.4g} m differs from the "
-                f"heights' rms {math.sqrt(h2):.4g} m by {100 * dev:+.2f} %: the map does not "
-                f"resolve its longest wavelengths (roll-off below ~10·2π/L) or has roughness "
-                f"beyond the Nyquist wavevector π/a (FFT corners)", RuntimeWarning, stacklevel=2)
+        _check_parseval(psd, h2)
     psd.window, psd.periodic, psd.source = win, periodic, source
     psd.h_rms_heights = math.sqrt(h2)
     psd.parseval = psd.h_rms / psd.h_rms_heights - 1.0
