@@ -277,3 +277,19 @@ def test_effective_modulus_two_solids():
     # two identical solids: half the single-solid value
     assert _rel(float(fastcontact.effective_modulus(E1, n1, E2=E1, nu2=n1)),
                 0.5 * E1 / (1 - n1 ** 2)) < 1e-14
+
+
+def test_e1_matches_mpmath_to_1e_15():
+    import mpmath as mp
+
+    from fastcontact.kernels.special import e1, e1_and_exp
+
+    mp.mp.dps = 30
+    rng = np.random.default_rng(5)
+    xs = np.concatenate([np.exp(rng.uniform(math.log(1e-14), math.log(700.0), 400)),
+                         [1.0, 1.0 + 1e-15, 2.0, 4.0, 63.999999, 64.0, 64.000001, 700.0]])
+    for x in xs:
+        ref = float(mp.e1(mp.mpf(float(x))))
+        assert abs(e1(float(x)) / ref - 1.0) <= 1e-15, x
+        assert e1_and_exp(float(x))[1] == math.exp(-float(x))
+    assert e1(0.0) == math.inf and e1(800.0) == 0.0

@@ -274,3 +274,89 @@ def test_cli_rebuilds_default_tables_into_a_folder(tmp_path):
     for name in DEFAULT_SURFACES:
         rebuilt = Tables.from_parquet(tmp_path / f"{name}.parquet")
         assert rebuilt.equals(load_default_tables(name), rtol=1e-10)
+
+
+# --------------------------------------------------------------------------- integrity (issue 15.5)
+def _forge(src, dst, mutate, redigest=False):
+    """Rewrite a table file's metadata; with ``redigest`` recompute its metadata_sha256 (a
+    consistent forgery that only the surface-hash check can catch)."""
+    from fastcontact.tables.store import _metadata_digest
+
+    table = pq.read_table(src)
+    meta = json.loads(table.schema.metadata[b"fastcontact"])
+    mutate(meta)
+    if redigest:
+        meta["metadata_sha256"] = _metadata_digest(meta)
+    pq.write_table(table.replace_schema_metadata({b"fastcontact": json.dumps(meta).encode()}), dst)
+
+
+@pytest.mark.parametrize("mutate", [
+    lambda m: m["options"].__setitem__("alpha_cj", 0.54),
+    lambda m: m["info"]["percolation_p_over_E"].__setitem__("emt", 1e-3),
+    lambda m: m["grids"].__setitem__("p_over_E", [-9.0, 0.5, 100]),
+    lambda m: m.__setitem__("theories", ["average", "emt", "critical_junction"]),
+    lambda m: m["info"].__setitem__("interpolation_error", {}),
+], ids=["options.alpha_cj", "info.percolation", "grids", "theories", "info.errors"])
+def test_edited_metadata_is_refused(tables, tmp_path, mutate):
+    path = tables.to_parquet(tmp_path / "t.parquet")
+    bad = tmp_path / "edited.parquet"
+    _forge(path, bad, mutate)
+    with pytest.raises(ValueError, match=r"metadata .* do not match the recorded SHA-256 hash"):
+        Tables.from_parquet(bad)
+    # the unedited file still loads, and re-writing it is deterministic in its digest
+    assert Tables.from_parquet(path).metadata()["metadata_sha256"] == \
+        json.loads(pq.read_schema(path).metadata[b"fastcontact"])["metadata_sha256"]
+
+
+def test_consistently_forged_surface_is_refused_by_its_fingerprint(tables, tmp_path):
+    path = tables.to_parquet(tmp_path / "t.parquet")
+    bad = tmp_path / "forged.parquet"
+    _forge(path, bad, lambda m: m["surface"].__setitem__("h_rms", 2e-5), redigest=True)
+    with pytest.raises(ValueError, match="surface hash does not match"):
+        Tables.from_parquet(bad)
+
+
+def test_table_of_another_surface_is_refused_showing_both(tables):
+    other = fc.SelfAffinePSD(h_rms=2e-5, hurst=0.8, q0=1e4, q1=1e8, q_roll=3e4)
+    with pytest.raises(ValueError, match="does not match the scene") as exc:
+        tables.check_surface(other, "the scene's surface")
+    assert repr(tables.surface) in str(exc.value) and repr(other) in str(exc.value)
+    tables.check_surface(tables.surface)  # the same surface passes
+
+
+def test_percolation_pressure_in_pascal(tables, psd):
+    E = 3.0e6
+    pp = tables.percolation_pressure("emt", E)
+    assert pp == pytest.approx(float(contact.percolation_pressure(psd, E, 0.5)), rel=1e-14)
+    assert tables.percolation_pressure("average", E) == math.inf
+    with pytest.raises(ValueError, match="E_star"):
+        tables.percolation_pressure("emt", -1.0)
+
+
+def test_kernel_data_is_a_named_record_with_the_positional_layout(tables):
+    from fastcontact.kernels.lookup import TableKernel
+
+    tab = tables.kernel_data("critical_junction")
+    assert isinstance(tab, TableKernel) and isinstance(tab, tuple) and len(tab) == 15
+    assert tab[0] is tab.lnp and tab[7] == tab.bp_lo and tab[13] is tab.d2lnu
+    assert tab[5] == math.log(tables.info["percolation_p_over_E"]["critical_junction"])
+
+
+def test_installed_package_is_never_written_into(monkeypatch):
+    from fastcontact.tables import defaults
+
+    monkeypatch.setattr(defaults, "SOURCE_CHECKOUT", None)
+    with pytest.raises(ValueError, match="outdirs"):
+        defaults.build_default_tables(names=["copper_012mm"])
+
+
+def test_bad_inputs_name_parameter_value_and_unit(tables, psd):
+    with pytest.raises(ValueError, match="grid"):
+        precompute(psd, grid=(1, 2))
+    with pytest.raises(ValueError, match="E_star"):
+        tables.mean_separation(1e-3, float("nan"))
+    with pytest.raises(ValueError, match=r"^p = "):
+        tables.sigma_bar(float("inf"), 1.0, "emt")
+    lo, hi = tables.p_range
+    with pytest.raises(TableRangeError, match=r"Pa is invalid: outside the table.*Pa at E\* = 2e\+06 Pa"):
+        tables.mean_separation(hi * 4e6, 2e6)

@@ -76,11 +76,13 @@ def _node_terms(s, sj, hzj, almqvist, ghx, ghw):
 
 
 @njit(cache=True)
-def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw):
+def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw, guess=0.0):
     """Solve Σ_j W_j 2s/(s + σ_j) + 2 A1 - 1 = 0 for s > 0 (2-D Bruggeman, reduced units).
 
     With ``almqvist`` each node is a reflected Gaussian of width hz[j] around u1 = σ_j^(1/3)
-    (Gauss–Hermite nodes ghx, ghw). Returns 0 when A1 >= 0.5 (percolated).
+    (Gauss–Hermite nodes ghx, ghw). Safeguarded Newton in ln s, started from ``guess`` when
+    it is inside the bracket (warm start), else from the bracket's middle. Returns 0 when
+    A1 >= 0.5 (percolated).
     """
     if A1 >= 0.5:
         return 0.0
@@ -103,6 +105,8 @@ def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw):
         lo -= 30.0
     hi = math.log(smax) + 1.0
     y = 0.5 * (lo + hi)
+    if guess > 0.0 and lo < math.log(guess) < hi:
+        y = math.log(guess)
     for it in range(200):
         s = max(math.exp(y), 1e-300)
         f = 2.0 * A1 - 1.0
@@ -180,7 +184,7 @@ def emt_sigma(sk, pbar, h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx, ghw,
     est = 0.0
     while True:
         n = 15 * npan
-        s = bruggeman(WK[:n], sig[:n], A1, almqvist, hz[:n], ghx, ghw)
+        s = bruggeman(WK[:n], sig[:n], A1, almqvist, hz[:n], ghx, ghw, s)
         if s <= 0.0:
             return 0.0, 0.0, n
         # per-panel error of the Bruggeman residual, relative to d f / d ln s

@@ -46,7 +46,7 @@ __all__ = ["sigma_directional", "directional_sigma_bar", "DirectionalTable",
 
 FORMS = ("self_consistent", "fixed")
 #: composite Gauss–Legendre panels (order 10) in the graded variable t of A (see Notes)
-N_PANELS = 24
+N_PANELS = 48
 GL_ORDER = 10
 GRADE = 3.0
 
@@ -58,9 +58,11 @@ def _residual(s, W, sig, A1, lam):
     f = A1 * (1.0 + lam) / lam - 1.0
     df = 0.0
     for j in range(W.size):
+        if W[j] == 0.0:
+            continue
         d = lam * s + sig[j]
         f += W[j] * (1.0 + lam) * s / d
-        df += W[j] * (1.0 + lam) * s * sig[j] / (d * d)
+        df += W[j] * (1.0 + lam) * (s / d) * (sig[j] / d)
     return f, df
 
 
@@ -123,22 +125,22 @@ def _solve_self_consistent(W, sig, A1, gam):
 # =========================================================================== P(u) nodes
 def _zeta_of_area(psd, pbar, area):
     """ζ with A(ζ)/A0 = area at reduced pressure pbar (bisection in ln q on the closed-form
-    moment ∫_{q0}^{q} q³C dq = (4/π)(p̄/(2 erfinv A))²)."""
+    moment ∫_{q0}^{q} q³C dq = (4/π)(p̄/(2 erfinv A))²); arrays broadcast."""
     target = 4.0 / math.pi * (pbar / (2.0 * erfinv(area))) ** 2
-    lo = np.full(area.shape, math.log(psd.q0))
-    hi = np.full(area.shape, math.log(psd.q1))
-    for _ in range(64):
+    lo = np.full(target.shape, math.log(psd.q0))
+    hi = np.full(target.shape, math.log(psd.q1))
+    for _ in range(60):
         mid = 0.5 * (lo + hi)
-        m = np.asarray(psd.moment(3.0, psd.q0, np.exp(mid)))
-        big = m > target
+        big = np.asarray(psd.moment(3.0, psd.q0, np.exp(mid))) > target
         hi = np.where(big, mid, hi)
         lo = np.where(big, lo, mid)
     return np.clip(np.exp(0.5 * (lo + hi)) / psd.q0, 1.0, psd.zeta1)
 
 
 def _nodes(psd, pbar, gamma, n_panels):
-    """(W, σ̄_j = (u1/h)³, A1): the u1-based P(u) of SPEC-style EMT on graded GL nodes in A."""
-    A1 = float(erf(pbar / (2.0 * math.sqrt(0.25 * math.pi * psd.cum3[-1]))))
+    """(W, σ̄ = (u1/h)³, A1) per pressure (rows): the u1-based P(u) of the Bruggeman medium
+    on graded Gauss–Legendre nodes in A ∈ [A(ζ1), 1] (masked u1 → zero weight)."""
+    A1 = erf(pbar / (2.0 * math.sqrt(0.25 * math.pi * psd.cum3[-1])))
     x, w = np.polynomial.legendre.leggauss(GL_ORDER)
     edges = np.linspace(0.0, 1.0, n_panels + 1)
     half = 0.5 * np.diff(edges)
@@ -148,15 +150,18 @@ def _nodes(psd, pbar, gamma, n_panels):
     tm, om = t ** m, (1.0 - t) ** m
     s = tm / (tm + om)
     ds = m * (t * (1.0 - t)) ** (m - 1.0) / (tm + om) ** 2
-    area = A1 + (1.0 - A1) * s
-    W = (1.0 - A1) * ds * wt
-    ok = (area < 1.0) & (area > A1)
-    zeta = _zeta_of_area(psd, pbar, np.where(ok, area, 0.5))
-    u = u1(psd, pbar, 1.0, zeta, gamma)
+    area = A1[:, None] + (1.0 - A1[:, None]) * s[None, :]
+    W = (1.0 - A1[:, None]) * (ds * wt)[None, :]
+    ok = (area < 1.0) & (area > A1[:, None])
+    P = np.broadcast_to(pbar[:, None], area.shape)
+    zeta = _zeta_of_area(psd, P, np.where(ok, area, 0.5))
+    u = u1(psd, P.ravel(), 1.0, zeta.ravel(), gamma).reshape(area.shape)
     mask = np.ma.getmaskarray(u) | ~ok
-    sig = (np.ma.filled(u, 0.0) / psd.h_rms) ** 3
-    W = np.where(mask, 0.0, W)
-    return np.ascontiguousarray(W), np.ascontiguousarray(np.where(mask, 0.0, sig)), A1
+    with np.errstate(over="ignore"):
+        sig = (np.ma.filled(u, 0.0) / psd.h_rms) ** 3
+    mask |= ~np.isfinite(sig)
+    return (np.ascontiguousarray(np.where(mask, 0.0, W)),
+            np.ascontiguousarray(np.where(mask, 0.0, sig)), A1)
 
 
 def directional_sigma_bar(psd, pbar, anisotropy, *, form="self_consistent", gamma=1.0,
@@ -168,13 +173,14 @@ def directional_sigma_bar(psd, pbar, anisotropy, *, form="self_consistent", gamm
     pbar = np.atleast_1d(np.asarray(pbar, dtype=np.float64)).ravel()
     sx = np.empty(pbar.size)
     sy = np.empty(pbar.size)
-    for i, pb in enumerate(pbar):
-        W, sig, A1 = _nodes(psd, float(pb), gamma, int(n_panels))
+    W, sig, A1 = _nodes(psd, pbar, gamma, int(n_panels))
+    g = float(anisotropy)
+    for i in range(pbar.size):
         if form == "self_consistent":
-            sx[i], sy[i] = _solve_self_consistent(W, sig, A1, float(anisotropy))
+            sx[i], sy[i] = _solve_self_consistent(W[i], sig[i], float(A1[i]), g)
         else:
-            sx[i] = _solve_dir(W, sig, A1, float(anisotropy))
-            sy[i] = _solve_dir(W, sig, A1, 1.0 / float(anisotropy))
+            sx[i] = _solve_dir(W[i], sig[i], float(A1[i]), g)
+            sy[i] = _solve_dir(W[i], sig[i], float(A1[i]), 1.0 / g)
     return sx, sy
 
 

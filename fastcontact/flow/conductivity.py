@@ -15,9 +15,11 @@ doi:10.1140/epje/i2010-10626-9 and Eur. Phys. J. E 31, 159 (2010), doi:10.1140/e
 """
 from __future__ import annotations
 
+import contextlib
 from typing import NamedTuple, Optional
 
 import numpy as np
+from numba import get_parallel_chunksize, set_parallel_chunksize
 
 from .._core.validate import check_positive, check_range
 from .._core.vocab import THEORIES
@@ -83,6 +85,17 @@ class FlowFactor(NamedTuple):
     percolated: np.ndarray     #: bool
 
 
+@contextlib.contextmanager
+def _dynamic_schedule():
+    """prange hands out one pressure at a time (their costs differ by 100x near percolation)."""
+    old = get_parallel_chunksize()
+    set_parallel_chunksize(1)
+    try:
+        yield
+    finally:
+        set_parallel_chunksize(old)
+
+
 def check_theory(theory):
     """``theory`` if it names a flow theory, else ValueError listing them."""
     if theory not in THEORIES:
@@ -127,15 +140,17 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
     if theory == "critical_junction":
         u1c = np.empty(pbar.size)
         zc = np.empty(pbar.size)
-        critical_junction_kernel(sk, pbar, gamma, float(a_perc), k_table(), glx, glw, float(panel),
-                                 u1c, zc, perc)
+        with _dynamic_schedule():
+            critical_junction_kernel(sk, pbar, gamma, float(a_perc), k_table(), glx, glw,
+                                     float(panel), u1c, zc, perc)
         return SigmaBar((alpha_cj * u1c / h) ** 3, perc, SigmaDetails(u1c=u1c / h, zeta_c=zc))
     ghx, ghw = gauss_hermite(GH_ORDER)
     sig = np.empty(pbar.size)
     err = np.empty(pbar.size)
     nev = np.empty(pbar.size, dtype=np.int64)
-    emt_kernel(sk, pbar, h, gamma, k_table(), glx, glw, float(panel), bool(almqvist), ghx, ghw,
-               int(n_start), float(tol), sig, perc, err, nev)
+    with _dynamic_schedule():
+        emt_kernel(sk, pbar, h, gamma, k_table(), glx, glw, float(panel), bool(almqvist), ghx,
+                   ghw, int(n_start), float(tol), sig, perc, err, nev)
     return SigmaBar(sig, perc, SigmaDetails(error_estimate=err, u1_evaluations=nev))
 
 

@@ -109,7 +109,10 @@ def _exact(psd, pbar, theories, sig_opts):
     h = psd.h_rms
     out = {"u": u / h, "dlnu": du / u, "d2lnu": d2u / u - (du / u) ** 2}
     for th in theories:
-        sb, perc, extra = sigma_bar(psd, pbar, th, **sig_opts)
+        if th == "average":  # σ̄ = (ū/h_rms)³ from the quadrature above, not a second one
+            sb, perc, extra = out["u"] ** 3, np.zeros(pbar.size, dtype=bool), None
+        else:
+            sb, perc, extra = sigma_bar(psd, pbar, th, **sig_opts)
         out[f"sigma_{th}"] = sb
         out[f"percolated_{th}"] = perc
         if th == "average":
