@@ -24,6 +24,7 @@ from reference.squeeze_reference import SqueezeReference, flat_stefan_time, tau0
 import fastcontact  # noqa: E402
 from fastcontact.squeeze import squeeze_history, squeeze_model, squeeze_out  # noqa: E402
 from fastcontact.tables import precompute  # noqa: E402
+from fastcontact._core.vocab import column_name  # noqa: E402
 
 E = 1e7
 ETA = 1e-3
@@ -68,7 +69,7 @@ def test_times_vs_reference(T, theory, pi0):
         assert _rel(df["tau0"].iloc[0], tau) < 1e-14
         assert _rel(df["u_start"].iloc[0] / T.h_rms, ref.default_start()) < 1e-7
         for r in ratios:
-            got = df[f"t_ratio_{r:g}"].iloc[0] / tau
+            got = df[column_name("t_ratio", r)].iloc[0] / tau
             assert _rel(got, want[r]) < 1e-6, (method, r, got, want[r])
         assert df["t_star"].iloc[0] == df["t_ratio_1.01"].iloc[0]
         assert not df["trapped"].iloc[0] and not df["out_of_table"].iloc[0]
@@ -80,7 +81,7 @@ def test_du_and_user_start_vs_reference(T):
     tau = tau0(ETA, R, T.h_rms, pi0 * E)
     du = 1e-7  # 0.01 h_rms
     df = squeeze_out(T, p0=pi0 * E, E_star=E, R=R, eta=ETA, du=(du,), ratios=())
-    assert _rel(df[f"t_du_{du:g}"].iloc[0] / tau, ref.t_du(du / T.h_rms)) < 1e-6
+    assert _rel(df[column_name("t_du", du)].iloc[0] / tau, ref.t_du(du / T.h_rms)) < 1e-6
     assert "t_star" in df  # t* always computed even if 1.01 is not in ratios
     for vs in (5.0, 1e4):  # inside the table, and far beyond its top (analytic tail)
         df = squeeze_out(T, p0=pi0 * E, E_star=E, R=R, eta=ETA, u_start=vs * T.h_rms)
@@ -144,7 +145,7 @@ def test_flat_surface_limit_far_from_equilibrium(T):
     ua = 1e4 * h
     times = [flat_stefan_time(ua, ub, pi0 * E, ETA, R) for ub in (1e3 * h, 300 * h, 100 * h)]
     df = squeeze_out(T, p0=pi0 * E, E_star=E, R=R, eta=ETA, u_start=ua, times=times)
-    got = np.array([df[f"u_at_{t:g}"].iloc[0] for t in times])
+    got = np.array([df[column_name("u_at", t)].iloc[0] for t in times])
     np.testing.assert_allclose(got, [1e3 * h, 300 * h, 100 * h], rtol=1e-6)
     hist = squeeze_history(T, pi0 * E, E, R, ETA, "average", t=np.array(times), u_start=ua)
     np.testing.assert_allclose(hist["u"], hist["u_flat"], rtol=1e-6)
@@ -177,8 +178,9 @@ def test_validation_errors(T):
         squeeze_out(T, **kw, du=(-1e-6,))
     with pytest.raises(ValueError, match="theory"):
         squeeze_out(T, **kw, theory="bogus")
-    with pytest.raises(ValueError, match="u_start"):
-        squeeze_out(T, **kw, u_start=1e-9)  # below equilibrium
+    # a start below equilibrium is a state, not an input error: NaN and a status (issue 11.6)
+    df = squeeze_out(T, **kw, u_start=1e-9)
+    assert df["status"].iloc[0] == "start_below_equilibrium" and np.isnan(df["t_star"].iloc[0])
     with pytest.raises(ValueError, match="tables"):
         squeeze_out(None, **kw)
     with pytest.raises(ValueError, match="method"):
@@ -210,7 +212,7 @@ def test_properties(T, lp, le, lr, theory):
     df = squeeze_out(T, p0=pi0 * E, E_star=E, R=Rr, eta=eta, theory=theory, times=times)
     row = df.iloc[0]
     assert not row["out_of_table"]
-    u = np.array([row[f"u_at_{t:g}"] for t in times])
+    u = np.array([row[column_name("u_at", t)] for t in times])
     floor = row["u_trap"] if row["trapped"] else row["u_inf"]
     assert np.all(np.isfinite(u)) and np.all(np.diff(u) <= 0) and np.all(u >= floor)
     assert u[0] <= row["u_start"]

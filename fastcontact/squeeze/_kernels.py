@@ -296,7 +296,7 @@ def _case_times(tab, mp, x0, vs, vb, trapped, tg, tau, h, quad, i, out):
     out.t_trap[i] = tau * t_trap
     tp = 0.0
     wp = math.log(vs - vb) if vs > vb else -math.inf
-    col = i if tg.times.shape[1] > 1 else 0
+    col = i if tg.times.shape[1] > 1 else i - i  # same integer type as i
     for k in range(out.U.shape[0]):
         tk = tg.times[k, col] / tau
         if vs <= vb:
@@ -327,18 +327,9 @@ def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
 
 
 @njit(parallel=True, cache=True)
-def quad_kernel(tab, mp, cs, h, tg, quad, out):
-    """method="quad": every case by per-case quadrature (one prange pass)."""
-    for i in prange(cs.p0.size):
-        tau = 3.0 * cs.eta[i] * cs.R[i] * cs.R[i] / (2.0 * h * h * cs.p0[i])
-        out.tau0[i] = tau
-        quad_case(tab, mp, math.log(cs.p0[i] / cs.E[i]), cs.us[i] / h, tg, tau, h, quad, i, out)
-
-
-@njit(cache=True)
 def p_of_v_kernel(tab, mp, v, out):
     """π_c(v) of the model (tables + analytic tail) at reduced separations v."""
-    for i in range(v.size):
+    for i in prange(v.size):
         out[i] = math.exp(_state(tab, mp, v[i])[0])
 
 
