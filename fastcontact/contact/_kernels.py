@@ -200,6 +200,24 @@ def f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder):
 
 
 @njit(cache=True)
+def _tau_lower(qb, c, e, cum3, a, ia, ca, P, tau_hi):
+    """Lower end in τ of the (A4) integrals: where s0² = S2_CUT (linearised w, then checked
+    with the exact moment), at most tau_hi - 1e-3 and at least TAU_FLOOR."""
+    dlo = P * P / (math.pi * a ** 3 * ca * S2_CUT)
+    tau_lo = math.log(dlo / a)
+    if tau_lo > tau_hi - 1e-3:
+        tau_lo = tau_hi - 1e-3
+    while tau_lo > TAU_FLOOR:
+        m = m3_from(qb, c, e, cum3, a, ia, math.exp(tau_lo))
+        if P * P / (math.pi * m) >= S2_CUT:
+            break
+        tau_lo -= 1.0
+    if tau_lo < TAU_FLOOR:
+        tau_lo = TAU_FLOOR
+    return tau_lo
+
+
+@njit(cache=True)
 def separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, out):
     """(I_F, I_g, J, I_g') for lower limit ``a`` [1/m] and reduced pressure P into out[0:4] [m].
 
@@ -224,19 +242,8 @@ def separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, out):
     lin3 = abs(k3) < 1e-12
     end_ia = qb[ia + 1]
     lna = math.log(a)
-    # lower cut: where s0² = S2_CUT (linearised w, then checked with the exact moment)
     ca = c[ia] * (a / qb[ia]) ** e[ia]
-    dlo = P * P / (math.pi * a ** 3 * ca * S2_CUT)
-    tau_lo = math.log(dlo / a)
-    if tau_lo > tau_hi - 1e-3:
-        tau_lo = tau_hi - 1e-3
-    while tau_lo > TAU_FLOOR:
-        m = m3_from(qb, c, e, cum3, a, ia, math.exp(tau_lo))
-        if P * P / (math.pi * m) >= S2_CUT:
-            break
-        tau_lo -= 1.0
-    if tau_lo < TAU_FLOOR:
-        tau_lo = TAU_FLOOR
+    tau_lo = _tau_lower(qb, c, e, cum3, a, ia, ca, P, tau_hi)
     # panels, graded: width `panel` near the two features of the integrands (s0 ~ 1 at
     # tau_1, and q - a ~ a at tau = 0), growing to GRADE_MAX * panel away from them where
     # the integrands are smooth exponentials in tau; split at kinks
