@@ -10,6 +10,8 @@ from __future__ import annotations
 import io
 import logging
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pandas as pd
@@ -19,9 +21,10 @@ from fastcontact.surface.io import CE_2D_SERIES, psd_from_surface_topography, re
 from fastcontact.surface.psd import SelfAffinePSD
 from fastcontact.surface.topography import psd_from_heights, synthetic_heights
 
-SurfaceTopography = pytest.importorskip(
-    "SurfaceTopography", reason='pip install "fastcontact[topography]"')
+# the optional extra is installed in CI (pip install ".[test]" pulls it in): no skip
 from SurfaceTopography import NonuniformLineScan, Topography, UniformLineScan  # noqa: E402
+
+from fastcontact.surface.io import read_topography  # noqa: E402
 
 A_UM = 0.5                        # pixel size [µm]
 N = 256
@@ -283,3 +286,28 @@ def test_known_psd_recovered_from_nonperiodic_crops():
     band = q >= 8 * q_lo
     np.testing.assert_allclose(mean[band], 1.0, atol=0.10)
     assert raw_worst > math.log(1.3)
+
+
+# ------------------------------------------------------------------ measured files
+def test_read_topography_file_to_psd(tmp_path, surface):
+    """A measured file (NetCDF written by SurfaceTopography, heights in µm, non-periodic)
+    -> SurfaceTopography container -> Persson PSD in SI with h_rms of the heights."""
+    _, h = surface
+    path = tmp_path / "scan.nc"
+    Topography(h[:128, :128] * 1e6, (64.0, 64.0), unit="um", periodic=False).to_netcdf(path)
+    psd = psd_from_heights(read_topography(path))
+    assert psd.window == "hann"
+    assert psd.h_rms == pytest.approx(np.std(h[:128, :128]), rel=1e-3)
+    assert psd.q1 == pytest.approx(math.pi / 0.5e-6, rel=1e-9)
+    with pytest.raises(ValueError, match="no such file"):
+        read_topography(tmp_path / "missing.nc")
+
+
+def test_missing_extra_is_one_line():
+    code = ("import sys; sys.modules['SurfaceTopography'] = None\n"
+            "from fastcontact.surface.io import read_topography\n"
+            "try:\n    read_topography('x.nc')\nexcept ImportError as e:\n    print(e)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert out.stdout.strip() == ('reading topography files needs SurfaceTopography: '
+                                  'pip install "fastcontact[topography]"'), out.stderr
