@@ -5,12 +5,15 @@ For several surfaces, build the three-theory tables
   (b) with adaptive refinement at 100, 10, 1 (the default, TOLERANCE) and 0.1 times the
       default tolerances,
 and report the build time (median of repeats, warm numba cache) and the maximum relative
-interpolation error of ū, p_cont(ū) and σ̄ of each theory. Errors are measured against the
+interpolation error of ū, p_cont(ū) and σ̄ of each theory. With ``--speed BASELINE_DIR``
+(a checkout of an earlier fastcontact, e.g. ``git archive 7f7ec20 fastcontact | tar -x -C DIR``)
+it instead times the default three-theory precompute of each surface in this checkout and in
+the baseline (separate processes, alternating, wall and CPU medians) and records both. Errors are measured against the
 direct quadrature at 200 random log-uniform pressures per surface that are neither nodes
 nor refinement midpoints (σ̄: only where A(ζ1)/A0 <= 0.4, "away from percolation", and
 σ̄ > 1e-24). Writes bench/tables_results.md; bench/RESULTS.md collects the fragments.
 
-    python bench/bench_tables.py [--repeats 3] [--quick]
+    python bench/bench_tables.py [--repeats 3] [--quick] [--speed BASELINE_DIR]
 """
 from __future__ import annotations
 
@@ -18,7 +21,11 @@ import argparse
 import math
 import os
 import platform
+import re
+import json
 import statistics
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -26,9 +33,9 @@ import numpy as np
 
 import fastcontact as fc
 from fastcontact import contact
-from fastcontact.conductivity import sigma_bar
-from fastcontact.defaults import DEFAULT_SURFACES, default_surface
+from fastcontact.flow.conductivity import sigma_bar
 from fastcontact.tables import TOLERANCE, default_grid, precompute
+from fastcontact.tables.defaults import DEFAULT_SURFACES, default_surface
 
 THEORIES = ("average", "critical_junction", "emt")
 
@@ -64,6 +71,75 @@ def errors(t, ref):
     return out
 
 
+_TIMER = r"""
+import json, sys, time
+import numpy as np
+import fastcontact as fc
+from fastcontact.defaults import default_surface
+from fastcontact.tables import precompute
+name = sys.argv[1]
+psd = fc.SelfAffinePSD(1e-5, 0.8, 1e4, 1e9) if name == "S1" else default_surface(name)
+precompute(fc.SelfAffinePSD(1e-5, 0.8, 1e4, 1e6))  # numba cache loaded, kernels compiled
+t0, c0 = time.perf_counter(), time.process_time()
+t = precompute(psd)
+print(json.dumps({"wall": time.perf_counter() - t0, "cpu": time.process_time() - c0,
+                  "nodes": t.info["nodes"]}))
+"""
+
+
+def _time_in(pythonpath, name):
+    """One warm precompute of surface ``name`` in a fresh process importing ``pythonpath``."""
+    env = dict(os.environ, PYTHONPATH=str(pythonpath))
+    out = subprocess.run([sys.executable, "-c", _TIMER, name], env=env, capture_output=True,
+                         text=True, check=True, cwd="/")
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def speed(baseline, repeats):
+    """Markdown lines: precompute times here and in ``baseline``, alternating, per surface."""
+    here = Path(__file__).resolve().parent.parent
+    names = ["S1"] + sorted(DEFAULT_SURFACES)
+    lines = ["## Tables: three-theory precompute time (issue 11.3)", "",
+             f"Machine: {machine()}; load average at start {os.getloadavg()[0]:.1f}. Each number "
+             f"is the median of {repeats} warm builds (numba cache loaded, kernels compiled), "
+             f"each in a fresh process, this checkout and the baseline ({baseline}) alternating. "
+             "CPU = process CPU time (both threads), which is less sensitive to other load "
+             "than wall time.", "",
+             "| surface | nodes | before wall [s] | after wall [s] | wall ratio | before CPU [s] | "
+             "after CPU [s] | CPU ratio |", "|---|---|---|---|---|---|---|---|"]
+    for name in names:
+        runs = {"before": [], "after": []}
+        for _ in range(repeats):
+            runs["before"].append(_time_in(baseline, name))
+            runs["after"].append(_time_in(here, name))
+        med = {k: {m: statistics.median(r[m] for r in v) for m in ("wall", "cpu")}
+               for k, v in runs.items()}
+        b, a = med["before"], med["after"]
+        lines.append(f"| {name} | {runs['after'][0]['nodes']} | {b['wall']:.2f} | {a['wall']:.2f} | "
+                     f"{a['wall'] / b['wall']:.2f} | {b['cpu']:.2f} | {a['cpu']:.2f} | "
+                     f"{a['cpu'] / b['cpu']:.2f} |")
+        print(lines[-1], flush=True)
+    return lines + [""]
+
+
+def _write(sections):
+    """Write bench/tables_results.md, keeping the sections of the previous file not rerun."""
+    out = Path(__file__).with_name("tables_results.md")
+    old = out.read_text() if out.is_file() else ""
+    kept = {}
+    for block in re.split(r"(?m)^(?=## )", old):
+        if block.startswith("## Tables: three"):
+            kept["speed"] = block
+        elif block.startswith("## "):
+            kept["error"] = kept.get("error", "") + block
+    kept.update({k: "\n".join(v) + "\n" for k, v in sections.items()})
+    text = "".join(kept.get(k, "") for k in ("speed", "error"))
+    tmp = out.with_suffix(".md.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, out)
+    print(f"wrote {out}")
+
+
 def timed_build(psd, repeats, **kw):
     times = []
     t = None
@@ -78,7 +154,11 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="two surfaces, fewer configurations")
+    ap.add_argument("--speed", metavar="BASELINE_DIR", help="time precompute against a baseline")
     args = ap.parse_args()
+    if args.speed:
+        _write({"speed": speed(Path(args.speed).resolve(), args.repeats)})
+        return
     surfaces = {"S1 (SPEC §8, H=0.8, 5 decades)": fc.SelfAffinePSD(1e-5, 0.8, 1e4, 1e9)}
     surfaces.update({n: default_surface(n) for n in DEFAULT_SURFACES})
     from fastcontact.roaddb import synthetic_road_psd
@@ -120,11 +200,7 @@ def main():
                          f"{e['u']:.1e} | {e['p_of_u']:.1e} | {e['average']:.1e} | "
                          f"{e['critical_junction']:.1e} | {e['emt']:.1e} |")
         lines.append("")
-    out = Path(__file__).with_name("tables_results.md")
-    tmp = out.with_suffix(".md.tmp")
-    tmp.write_text("\n".join(lines) + "\n")
-    os.replace(tmp, out)
-    print(f"wrote {out}")
+    _write({"error": lines})
 
 
 if __name__ == "__main__":

@@ -360,3 +360,10 @@ def test_bad_inputs_name_parameter_value_and_unit(tables, psd):
     lo, hi = tables.p_range
     with pytest.raises(TableRangeError, match=r"Pa is invalid: outside the table.*Pa at E\* = 2e\+06 Pa"):
         tables.mean_separation(hi * 4e6, 2e6)
+
+
+def test_bad_tolerance_names_the_key(psd):
+    with pytest.raises(ValueError, match="tolerance"):
+        precompute(psd, theories=("average",), tolerance={"bogus": 1e-9})
+    with pytest.raises(ValueError, match=r"tolerance\['u'\]"):
+        precompute(psd, theories=("average",), tolerance={"u": float("nan")})

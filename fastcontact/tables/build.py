@@ -91,6 +91,17 @@ def _check_grid(grid):
     return g
 
 
+def _check_tolerance(tolerance):
+    """:data:`TOLERANCE` updated with the user's overrides (known keys, finite values > 0)."""
+    tol = dict(TOLERANCE)
+    for key, value in dict(tolerance or {}).items():
+        if key not in TOLERANCE:
+            raise ValueError(f"tolerance = {{{key!r}: ...}} is invalid: keys must be among "
+                             f"{sorted(TOLERANCE)}")
+        tol[key] = float(check_range(f"tolerance[{key!r}]", value, 1e-15, 1.0, "[-] (relative)"))
+    return tol
+
+
 def _cj_derivatives(psd, pbar, sb, sig_opts):
     """(d ln σ̄/d ln p̄, d² ln σ̄/d(ln p̄)²) of the critical junction by central differences."""
     eps = 1e-4
@@ -327,8 +338,7 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
         grid = default_grid(psd, gamma, ppd)
     else:
         grid = _check_grid(grid)
-    tol = dict(TOLERANCE)
-    tol.update(tolerance or {})
+    tol = _check_tolerance(tolerance)
     sig_opts = dict(gamma=gamma, a_perc=options["a_perc"], alpha_cj=options["alpha_cj"],
                     tol=options["emt_tol"], almqvist=options["emt_almqvist"])
     lnp, cols, errs, stats = _refine(psd, grid, theories, sig_opts, tol, refine)
