@@ -367,3 +367,20 @@ def test_bad_tolerance_names_the_key(psd):
         precompute(psd, theories=("average",), tolerance={"bogus": 1e-9})
     with pytest.raises(ValueError, match=r"tolerance\['u'\]"):
         precompute(psd, theories=("average",), tolerance={"u": float("nan")})
+
+
+def test_hermite_kernels_reproduce_a_quintic_and_agree_with_their_numpy_twin():
+    from fastcontact.kernels.hermite import quintic_interval, quintic_np, quintic_unit
+
+    c = np.array([0.3, -1.2, 0.7, 2.1, -0.4, 0.25])          # a quintic polynomial
+    P = np.polynomial.Polynomial(c)
+    x0, x1 = 0.4, 1.3
+    ends = [P(x0), P(x1), P.deriv()(x0), P.deriv()(x1), P.deriv(2)(x0), P.deriv(2)(x1)]
+    y0, y1, d0, d1, s0, s1 = ends
+    for x in np.linspace(x0, x1, 7):
+        v = quintic_interval(x, x0, x1, *ends)
+        assert abs(v - P(x)) < 1e-13
+        assert abs(quintic_np(x, x0, x1, *ends) - v) < 1e-13
+        assert abs(quintic_np(x, x0, x1, *ends, deriv=True) - P.deriv()(x)) < 1e-12
+        val, der = quintic_unit((x - x0) / (x1 - x0), x1 - x0, y0, d0, s0, y1, d1, s1)
+        assert abs(val - P(x)) < 1e-13 and abs(der - P.deriv()(x)) < 1e-12

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from numba import njit
 
-__all__ = ["cubic_uniform", "quintic_interval", "quintic_np"]
+__all__ = ["cubic_uniform", "quintic_interval", "quintic_unit", "quintic_np"]
 
 
 @njit(cache=True)
@@ -42,6 +42,31 @@ def quintic_interval(x, x0, x1, y0, y1, d0, d1, s0, s1):
             + (10.0 * t3 - 15.0 * t4 + 6.0 * t5) * y1
             + (-4.0 * t3 + 7.0 * t4 - 3.0 * t5) * h * d1
             + 0.5 * (t3 - 2.0 * t4 + t5) * h * h * s1)
+
+
+@njit(cache=True)
+def quintic_unit(t, h, y0, d0, s0, y1, d1, s1):
+    """(value, d/dx) of the quintic Hermite at t = (x - x0)/h in [0, 1], interval width h.
+
+    Same polynomial as :func:`quintic_interval` (written in the unit variable t), plus its slope.
+    """
+    t2 = t * t
+    t3 = t2 * t
+    t4 = t3 * t
+    t5 = t4 * t
+    val = ((1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5) * y0
+           + (t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5) * h * d0
+           + 0.5 * (t2 - 3.0 * t3 + 3.0 * t4 - t5) * h * h * s0
+           + (10.0 * t3 - 15.0 * t4 + 6.0 * t5) * y1
+           + (-4.0 * t3 + 7.0 * t4 - 3.0 * t5) * h * d1
+           + 0.5 * (t3 - 2.0 * t4 + t5) * h * h * s1)
+    der = ((-30.0 * t2 + 60.0 * t3 - 30.0 * t4) * y0
+           + (1.0 - 18.0 * t2 + 32.0 * t3 - 15.0 * t4) * h * d0
+           + 0.5 * (2.0 * t - 9.0 * t2 + 12.0 * t3 - 5.0 * t4) * h * h * s0
+           + (30.0 * t2 - 60.0 * t3 + 30.0 * t4) * y1
+           + (-12.0 * t2 + 28.0 * t3 - 15.0 * t4) * h * d1
+           + 0.5 * (3.0 * t2 - 8.0 * t3 + 5.0 * t4) * h * h * s1)
+    return val, der / h
 
 
 def quintic_np(x, x0, x1, y0, y1, d0, d1, s0, s1, deriv=False):
