@@ -33,12 +33,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 from scipy.interpolate import CubicSpline
-from scipy.special import erf, erfinv
+from scipy.special import erf
 
 from .._core.validate import check_positive, check_range
-from ..contact import area_fraction, percolation_pressure, u1
+from ..contact import area_fraction, percolation_pressure
+from ..contact._kernels import PANEL, psd_kernel, u1_at_area
+from ..kernels.quadrature import gauss_legendre
+from ..kernels.special import k_table
 from .conductivity import check_theory, conductivity
 
 __all__ = ["sigma_directional", "directional_sigma_bar", "DirectionalTable",
@@ -123,23 +126,25 @@ def _solve_self_consistent(W, sig, A1, gam):
 
 
 # =========================================================================== P(u) nodes
-def _zeta_of_area(psd, pbar, area):
-    """ζ with A(ζ)/A0 = area at reduced pressure pbar (bisection in ln q on the closed-form
-    moment ∫_{q0}^{q} q³C dq = (4/π)(p̄/(2 erfinv A))²); arrays broadcast."""
-    target = 4.0 / math.pi * (pbar / (2.0 * erfinv(area))) ** 2
-    lo = np.full(target.shape, math.log(psd.q0))
-    hi = np.full(target.shape, math.log(psd.q1))
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        big = np.asarray(psd.moment(3.0, psd.q0, np.exp(mid))) > target
-        hi = np.where(big, mid, hi)
-        lo = np.where(big, lo, mid)
-    return np.clip(np.exp(0.5 * (lo + hi)) / psd.q0, 1.0, psd.zeta1)
+@njit(cache=True, parallel=True)
+def _u1_nodes(sk, pbar, area, gamma, ktab, glx, glw, panel, out):
+    """out[i, j] = (u1 at A(ζ)/A0 = area[i, j], pressure pbar[i]) [m]; inf where masked."""
+    n, m = area.shape
+    for k in prange(n * m):
+        i = k // m
+        j = k - i * m
+        work = np.empty(4)
+        u, _a = u1_at_area(sk, area[i, j], pbar[i], gamma, ktab, glx, glw, panel, work)
+        out[i, j] = u
 
 
 def _nodes(psd, pbar, gamma, n_panels):
     """(W, σ̄ = (u1/h)³, A1) per pressure (rows): the u1-based P(u) of the Bruggeman medium
-    on graded Gauss–Legendre nodes in A ∈ [A(ζ1), 1] (masked u1 → zero weight)."""
+    on graded Gauss–Legendre nodes in A ∈ [A(ζ1), 1] (masked u1 → zero weight).
+
+    u1 is evaluated where A(ζ)/A0 equals each node *exactly* (contact core's u1_at_area):
+    at low pressure A(ζ) falls within ζ - 1 ~ (p/E*)² < 1e-16, where ζ is not representable.
+    """
     A1 = erf(pbar / (2.0 * math.sqrt(0.25 * math.pi * psd.cum3[-1])))
     x, w = np.polynomial.legendre.leggauss(GL_ORDER)
     edges = np.linspace(0.0, 1.0, n_panels + 1)
@@ -152,16 +157,16 @@ def _nodes(psd, pbar, gamma, n_panels):
     ds = m * (t * (1.0 - t)) ** (m - 1.0) / (tm + om) ** 2
     area = A1[:, None] + (1.0 - A1[:, None]) * s[None, :]
     W = (1.0 - A1[:, None]) * (ds * wt)[None, :]
-    ok = (area < 1.0) & (area > A1[:, None])
-    P = np.broadcast_to(pbar[:, None], area.shape)
-    zeta = _zeta_of_area(psd, P, np.where(ok, area, 0.5))
-    u = u1(psd, P.ravel(), 1.0, zeta.ravel(), gamma).reshape(area.shape)
-    mask = np.ma.getmaskarray(u) | ~ok
-    with np.errstate(over="ignore"):
-        sig = (np.ma.filled(u, 0.0) / psd.h_rms) ** 3
-    mask |= ~np.isfinite(sig)
-    return (np.ascontiguousarray(np.where(mask, 0.0, W)),
-            np.ascontiguousarray(np.where(mask, 0.0, sig)), A1)
+    ok = (area > A1[:, None]) & (area < 1.0)
+    glx, glw = gauss_legendre()
+    u = np.empty(area.shape)
+    _u1_nodes(psd_kernel(psd), np.ascontiguousarray(pbar), np.ascontiguousarray(
+        np.where(ok, area, 0.5)), float(gamma), k_table(), glx, glw, float(PANEL), u)
+    with np.errstate(over="ignore", invalid="ignore"):
+        sig = (np.maximum(u, 0.0) / psd.h_rms) ** 3
+    bad = ~ok | ~np.isfinite(sig)
+    return (np.ascontiguousarray(np.where(bad, 0.0, W)),
+            np.ascontiguousarray(np.where(bad, 0.0, sig)), A1)
 
 
 def directional_sigma_bar(psd, pbar, anisotropy, *, form="self_consistent", gamma=1.0,
@@ -269,6 +274,7 @@ class DirectionalTable:
     """
 
     def __init__(self, tables, anisotropy, theory, form, lnp, lnsig, lnp_perc, info):
+        """Built by :func:`precompute_directional`."""
         self.tables = tables
         self.anisotropy = float(anisotropy)
         self.theory = theory
@@ -307,47 +313,68 @@ class DirectionalTable:
         return self.sigma_bar(p, E_star, direction) * self.h_rms ** 3 / (12.0 * eta)
 
 
-def precompute_directional(tables, anisotropy, *, theory="emt", form="self_consistent",
-                           n_panels=N_PANELS):
-    """Tabulate σ̄_xx, σ̄_yy of ``tables.surface`` with γ_T = ``anisotropy`` on the tables' nodes.
+def _lnsig(sx, sy, lnp, lnp_perc):
+    out = {}
+    for d, sv in (("x", sx), ("y", sy)):
+        with np.errstate(divide="ignore"):
+            ls = np.where(sv > 1e-300, np.log(np.maximum(sv, 1e-300)), -np.inf)
+        ls = np.where(lnp >= lnp_perc[d], -np.inf, ls)
+        closed = ~np.isfinite(ls)
+        if np.any(closed):                  # closed from the first node at/after percolation on
+            ls[int(np.argmax(closed)):] = -np.inf
+        out[d] = ls
+    return out
 
-    The tables' options (γ of Yang–Persson) are reused; the worst relative error of the
-    spline at every interval midpoint (against the direct solver) is recorded in ``info``.
+
+def precompute_directional(tables, anisotropy, *, form="self_consistent", n_panels=N_PANELS,
+                           tol=1e-6, max_rounds=6, sigma_floor=1e-20):
+    """Tabulate σ̄_xx, σ̄_yy (effective medium) of ``tables.surface`` with γ_T = ``anisotropy``.
+
+    Starts from the tables' p̄ nodes and bisects every interval whose spline misses the
+    direct solver at its midpoint by more than ``tol`` (relative, where σ̄ > sigma_floor),
+    up to ``max_rounds`` times; the final midpoint errors go to ``info``. The tables'
+    Yang–Persson γ is reused.
+
+    Returns
+    -------
+    DirectionalTable
     """
     import time
 
     t0 = time.perf_counter()
-    g = _check(theory, anisotropy, "x", form)
-    if theory != "emt":
-        raise ValueError(f"theory = {theory!r} is invalid for precompute_directional: the "
-                         f"table path is for 'emt' (critical junction: use tables built with "
-                         f"the directional a_perc, see directional_threshold)")
+    g = _check("emt", anisotropy, "x", form)
     psd = tables.surface
     gamma = float(tables.options.get("gamma", 1.0))
-    pbar = np.asarray(tables.data["p_over_E"], dtype=np.float64)
-    lnp = np.log(pbar)
+    lnp = np.log(np.asarray(tables.data["p_over_E"], dtype=np.float64))
     thr = {"x": 0.5, "y": 0.5} if form == "self_consistent" else \
         {d: directional_threshold(0.5, g, d) for d in ("x", "y")}
     lnp_perc = {d: math.log(float(percolation_pressure(psd, 1.0, thr[d]))) for d in thr}
-    sx, sy = directional_sigma_bar(psd, pbar, g, form=form, gamma=gamma, n_panels=n_panels)
-    with np.errstate(divide="ignore"):
-        lnsig = {"x": np.where(sx > 1e-300, np.log(np.maximum(sx, 1e-300)), -np.inf),
-                 "y": np.where(sy > 1e-300, np.log(np.maximum(sy, 1e-300)), -np.inf)}
-    for d in ("x", "y"):   # closed from the first node at/after percolation on
-        lnsig[d] = np.where(lnp >= lnp_perc[d], -np.inf, lnsig[d])
-        first = np.argmax(~np.isfinite(lnsig[d])) if np.any(~np.isfinite(lnsig[d])) else lnp.size
-        lnsig[d][first:] = -np.inf
-    tab = DirectionalTable(tables, g, theory, form, lnp, lnsig, lnp_perc, {})
-    # midpoint errors (σ̄ above 1e-20: below it times and leak rates are negligible)
-    xm = 0.5 * (lnp[:-1] + lnp[1:])
-    mx, my = directional_sigma_bar(psd, np.exp(xm), g, form=form, gamma=gamma,
+    sx, sy = directional_sigma_bar(psd, np.exp(lnp), g, form=form, gamma=gamma,
                                    n_panels=n_panels)
-    err = {}
-    for d, m in (("x", mx), ("y", my)):
-        est = tab.sigma_bar(np.exp(xm), 1.0, d)
-        ok = (m > 1e-20) & (est > 0)
-        err[d] = float(np.max(np.abs(est[ok] / m[ok] - 1.0))) if np.any(ok) else 0.0
-    tab.info.update({"interpolation_error": err, "nodes": int(lnp.size),
+    rounds = 0
+    while True:
+        rounds += 1
+        tab = DirectionalTable(tables, g, "emt", form, lnp, _lnsig(sx, sy, lnp, lnp_perc),
+                               lnp_perc, {})
+        xm = 0.5 * (lnp[:-1] + lnp[1:])
+        mx, my = directional_sigma_bar(psd, np.exp(xm), g, form=form, gamma=gamma,
+                                       n_panels=n_panels)
+        bad = np.zeros(xm.size, dtype=bool)
+        err = {}
+        for d, m in (("x", mx), ("y", my)):
+            est = tab.sigma_bar(np.exp(xm), 1.0, d)
+            ok = (m > sigma_floor) & (est > 0)
+            e = np.where(ok, np.abs(est / np.where(ok, m, 1.0) - 1.0), 0.0)
+            err[d] = float(e.max())
+            bad |= e > tol
+        if not np.any(bad) or rounds >= max_rounds:
+            break
+        order = np.argsort(np.concatenate((lnp, xm[bad])))
+        lnp = np.concatenate((lnp, xm[bad]))[order]
+        sx = np.concatenate((sx, mx[bad]))[order]
+        sy = np.concatenate((sy, my[bad]))[order]
+    tab.info.update({"interpolation_error": err, "tolerance": tol, "nodes": int(lnp.size),
+                     "refinement_rounds": rounds,
                      "percolation_p_over_E": {d: math.exp(v) for d, v in lnp_perc.items()},
                      "anisotropy": g, "form": form, "n_panels": int(n_panels),
                      "build_seconds": time.perf_counter() - t0})
