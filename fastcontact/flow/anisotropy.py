@@ -327,7 +327,7 @@ def _lnsig(sx, sy, lnp, lnp_perc):
 
 
 def precompute_directional(tables, anisotropy, *, form="self_consistent", n_panels=N_PANELS,
-                           tol=1e-6, max_rounds=6, sigma_floor=1e-20):
+                           tol=1e-6, max_rounds=12, sigma_floor=1e-20):
     """Tabulate σ̄_xx, σ̄_yy (effective medium) of ``tables.surface`` with γ_T = ``anisotropy``.
 
     Starts from the tables' p̄ nodes and bisects every interval whose spline misses the

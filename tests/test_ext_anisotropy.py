@@ -1,0 +1,100 @@
+"""Issue 14.3: directional conductivities σ_xx, σ_yy for anisotropic roughness.
+
+Reference: ``tests/reference/ext_anisotropy.py`` builds P(u) as -A'(ζ)dζ on a grid in
+ln(ζ - 1) (public u1(ζ), closed-form A'(ζ)) and solves the Bruggeman equations with scipy
+brentq — a different discretisation and solver. γ_T = 1 must return the isotropic result
+exactly; the anisotropic solver forced at γ_T = 1 must agree with the isotropic EMT.
+"""
+from __future__ import annotations
+
+import math
+import os
+import sys
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reference.ext_anisotropy import p_of_u, sigma_fixed, sigma_self_consistent  # noqa: E402
+
+import fastcontact as fc  # noqa: E402
+from fastcontact.flow.anisotropy import (directional_sigma_bar, directional_threshold,  # noqa: E402
+                                         precompute_directional, sigma_directional)
+from fastcontact.flow.conductivity import conductivity  # noqa: E402
+
+E_STAR = 1e7
+
+
+@pytest.fixture(scope="module")
+def psd():
+    return fc.SelfAffinePSD(h_rms=5e-6, hurst=0.8, q0=1e4, q1=1e8)
+
+
+@pytest.mark.parametrize("theory", ["emt", "critical_junction", "average"])
+@pytest.mark.parametrize("direction", ["x", "y"])
+def test_isotropic_is_exact(psd, theory, direction):
+    p = np.array([1e3, 1e5, 1e6])
+    a = sigma_directional(psd, p, E_STAR, 1e-3, theory, 1.0, direction)
+    b = conductivity(psd, p, E_STAR, 1e-3, theory)
+    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+
+
+@pytest.mark.parametrize("form", ["self_consistent", "fixed"])
+def test_anisotropic_solver_at_gamma_one(psd, form):
+    p = np.array([1e-3, 1e2, 1e4, 1e5, 1e6, 1.9e6])       # ū from ~20 h_rms to near percolation
+    iso = conductivity(psd, p, E_STAR, 1.0 / 12.0, "emt", tol=1e-12)[0] / psd.h_rms ** 3
+    sx, sy = directional_sigma_bar(psd, p / E_STAR, 1.0, form=form)
+    np.testing.assert_allclose(sx, iso, rtol=2e-9)
+    np.testing.assert_allclose(sy, iso, rtol=2e-9)
+
+
+@pytest.mark.parametrize("p", [1e3, 1e5, 1e6])
+@pytest.mark.parametrize("gamma_t", [1.5, 4.0])
+def test_against_reference(psd, p, gamma_t):
+    W, sig, A1 = p_of_u(psd, p, E_STAR)
+    rf = sigma_fixed(W, sig, A1, gamma_t)
+    rs = sigma_self_consistent(W, sig, A1, gamma_t)
+    fx, fy = directional_sigma_bar(psd, p / E_STAR, gamma_t, form="fixed")
+    sx, sy = directional_sigma_bar(psd, p / E_STAR, gamma_t)
+    np.testing.assert_allclose([fx[0], fy[0], sx[0], sy[0]], [*rf, *rs], rtol=2e-8)
+    assert sx[0] > sy[0] and fx[0] > fy[0]          # easier along the long correlation length
+
+
+def test_percolation_thresholds(psd):
+    g = 3.0
+    # fixed form: σ_yy closes at A(ζ1)/A0 = 1/(1+γ), σ_xx at γ/(1+γ)
+    for d, a_thr in (("y", 1 / (1 + g)), ("x", g / (1 + g))):
+        assert abs(directional_threshold(0.5, g, d) - a_thr) < 1e-15
+        pc = float(fc.contact.percolation_pressure(psd, E_STAR, a_thr))
+        s_lo, perc_lo = sigma_directional(psd, pc * 0.999, E_STAR, 1e-3, "emt", g, d, form="fixed")
+        s_hi, perc_hi = sigma_directional(psd, pc * 1.001, E_STAR, 1e-3, "emt", g, d, form="fixed")
+        assert s_lo > 0 and not perc_lo and s_hi == 0 and perc_hi
+    # self-consistent: both close at 1/2, with σ_yy/σ_xx → 1/γ² just before
+    pc = float(fc.contact.percolation_pressure(psd, E_STAR, 0.5))
+    sx, sy = directional_sigma_bar(psd, np.array([0.97 * pc, 1.001 * pc]) / E_STAR, g)
+    assert sx[1] == 0 and sy[1] == 0
+    assert abs(sy[0] / sx[0] * g * g - 1) < 0.05
+
+
+def test_bad_input(psd):
+    with pytest.raises(ValueError, match="anisotropy"):
+        sigma_directional(psd, 1e4, E_STAR, 1e-3, "emt", 0.5, "x")
+    with pytest.raises(ValueError, match="direction"):
+        sigma_directional(psd, 1e4, E_STAR, 1e-3, "emt", 2.0, "z")
+    with pytest.raises(ValueError, match="form"):
+        sigma_directional(psd, 1e4, E_STAR, 1e-3, "critical_junction", 2.0, "x")
+
+
+def test_table_path(psd):
+    tables = fc.precompute(psd, theories=("emt",), points_per_decade=2, refine=False)
+    tab = precompute_directional(tables, 3.0, tol=1e-5)
+    assert tab.info["interpolation_error"]["x"] <= 1e-5
+    rng = np.random.default_rng(7)
+    p = np.exp(rng.uniform(math.log(tables.p_range[0] * E_STAR), math.log(1.5e6), 12))
+    sx, sy = directional_sigma_bar(psd, p / E_STAR, 3.0)
+    np.testing.assert_allclose(tab.sigma_bar(p, E_STAR, "x"), sx, rtol=3e-5)
+    np.testing.assert_allclose(tab.sigma_bar(p, E_STAR, "y"), sy, rtol=3e-5)
+    pc = float(fc.contact.percolation_pressure(psd, E_STAR, 0.5))
+    assert tab.sigma_bar(1.0001 * pc, E_STAR, "x") == 0.0
+    np.testing.assert_allclose(tab.conductivity(1e5, E_STAR, 2e-3, "y"),
+                               tab.sigma_bar(1e5, E_STAR, "y") * psd.h_rms ** 3 / (12 * 2e-3))
