@@ -35,7 +35,8 @@ scene = {
     "material": {"E": "10 MPa", "nu": 0.5},
     "fluid": {"eta": {"start": "1 mPa s", "stop": "1 Pa s", "num": n // 1000, "log": True}},
     "geometry": {"R": "2 cm"},
-    "outputs": {"columns": ["u_inf", "t_star", "t_ratio_*", "t_du_*", "trapped"]},
+    "outputs": {"columns": ["u_inf", "t_star", "t_ratio_*", "t_du_*", "trapped"],
+                "max_cases": 10**9},
 }
 sc = load_scene(scene)
 obtain_tables(sc.surfaces["a"], sc.theories, dict(sc.table_options))

@@ -26,6 +26,8 @@ import math
 import sys
 from pathlib import Path
 
+from .studies.progress import Progress
+
 __all__ = ["main", "build_parser"]
 
 EXIT_BAD_INPUT = 2
@@ -259,7 +261,11 @@ def _cmd_tables_build(a, out, err):
         raise CLIError(f"fastcontact tables build: -o {a.output!r} must end in .parquet")
     theories = _split_theories(a.theories)
     print(f"building tables for {psd!r}, theories {theories} ...", file=err)
-    T = precompute(psd, theories=theories, gamma=a.gamma, a_perc=a.a_perc, alpha_cj=a.alpha_cj)
+    with Progress(1, True, err) as prog:
+        prog.step("tabulating")
+        T = precompute(psd, theories=theories, gamma=a.gamma, a_perc=a.a_perc,
+                       alpha_cj=a.alpha_cj)
+        prog.advance()
     T.to_parquet(a.output)
     print(f"wrote {a.output} ({T.info['nodes']} nodes, {T.info['build_seconds']:.2f} s)", file=out)
     return 0
@@ -381,11 +387,14 @@ def _cmd_figures(a, out, err):
             raise SystemExit(f"fastcontact figures: {mod} has no {fn}()")
         funcs.append((mod, getattr(m, fn)))
     n = 0
-    for mod, fn in funcs:
-        print(f"{mod} ...", file=err)
-        for p in fn(outdir) or []:
-            print(f"figure: {p}", file=out)
-            n += 1
+    with Progress(len(funcs), True, err) as prog:
+        for mod, fn in funcs:
+            prog.step(mod.rsplit(".", 1)[-1])
+            print(f"{mod} ...", file=err)
+            for p in fn(outdir) or []:
+                print(f"figure: {p}", file=out)
+                n += 1
+            prog.advance()
     print(f"{n} figures in {outdir}", file=out)
     return 0
 

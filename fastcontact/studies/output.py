@@ -14,6 +14,8 @@ import pyarrow.parquet as pq
 
 from .._core.io import atomic_path, write_bytes_atomic
 from .._core.vocab import METADATA_KEY
+from .kinds import column_units
+from .schema import input_units
 
 __all__ = ["ParquetStream", "write_parquet_atomic", "write_json_atomic", "json_default",
            "column_summary"]
@@ -48,11 +50,13 @@ def write_json_atomic(path, obj) -> Path:
 
 
 def _table(df, units, metadata, schema=None):
-    """Arrow table of ``df`` with the unit of every column as field metadata."""
+    """Arrow table of ``df`` with the unit of every column as field metadata (known columns
+    get their SI unit even without ``units``: case inputs and engine results)."""
     table = pa.Table.from_pandas(df, preserve_index=False)
     if schema is not None:
         return table.cast(schema)
-    units = dict(units or {}, **df.attrs.get("units", {}))
+    known = {**input_units(), **{k: u for k, u in column_units(df.columns).items() if u}}
+    units = {**known, **(units or {}), **df.attrs.get("units", {})}
     fields = [f.with_metadata({"unit": units.get(f.name, "")}) for f in table.schema]
     meta = dict(table.schema.metadata or {})
     if metadata is not None:
@@ -122,9 +126,45 @@ class ParquetStream:
             os.unlink(self.tmp)
 
 
+class _Stats:
+    """Streaming min / max / true-count of one column over one group, and its median
+    (exact up to ``exact`` values; beyond that the median of an even sample of them)."""
+
+    def __init__(self, n, exact=1_000_000):
+        self.step = max(1, -(-n // exact))
+        self.lo, self.hi, self.true, self.rows, self.sample, self.seen = (
+            np.inf, -np.inf, 0, 0, [], 0)
+
+    def add_num(self, v):
+        w = v[np.isfinite(v)]
+        if w.size:
+            self.lo, self.hi = min(self.lo, w.min()), max(self.hi, w.max())
+            first = (-self.seen) % self.step
+            self.sample.append(w[first::self.step].copy())
+            self.seen += w.size
+
+    def num(self):
+        if not self.seen:
+            return None
+        return self.lo, float(np.median(np.concatenate(self.sample))), self.hi
+
+
+def _batches(pf, column, groups):
+    """Yield (group, values) pieces of ``column`` read batch by batch."""
+    start = 0
+    for batch in pf.iter_batches(columns=[column], batch_size=1 << 18):
+        col = batch.column(0)
+        stop = start + len(col)
+        for g, a, b in groups:
+            lo, hi = max(a, start), min(b, stop)
+            if lo < hi:
+                yield g, col.slice(lo - start, hi - lo)
+        start = stop
+
+
 def column_summary(path, columns, groups):
     """Per-group min / median / max (numbers) or true-count (flags) of ``columns`` of a
-    Parquet file, read one column at a time.
+    Parquet file, streamed (memory bounded whatever the file size).
 
     Parameters
     ----------
@@ -137,24 +177,24 @@ def column_summary(path, columns, groups):
     -------
     dict
         ``{group: [(column, kind, values)]}`` with kind ``"num"`` → (min, median, max) of the
-        finite values or None, ``"bool"`` → (true count, rows).
+        finite values or None, ``"bool"`` → (true count, rows). Medians of groups over 1e6
+        rows are those of an even sample of 1e6 values.
     """
     pf = pq.ParquetFile(path)
-    names = set(pf.schema_arrow.names)
+    types = {f.name: f.type for f in pf.schema_arrow}
     out = {g: [] for g, _, _ in groups}
     for c in columns:
-        if c not in names:
+        t = types.get(c)
+        if t is None or not (pa.types.is_boolean(t) or pa.types.is_floating(t)):
             continue
-        col = pf.read(columns=[c]).column(c)
-        if pa.types.is_boolean(col.type):
-            for g, a, b in groups:
-                part = col.slice(a, b - a)
-                out[g].append((c, "bool", (int(pc.sum(part).as_py() or 0), b - a)))
-        elif pa.types.is_floating(col.type):
-            v = col.to_numpy()
-            for g, a, b in groups:
-                w = v[a:b]
-                w = w[np.isfinite(w)]
-                out[g].append((c, "num", (w.min(), np.median(w), w.max()) if w.size else None))
-        del col
+        stats = {g: _Stats(b - a) for g, a, b in groups}
+        for g, part in _batches(pf, c, groups):
+            if pa.types.is_boolean(t):
+                stats[g].true += int(pc.sum(part).as_py() or 0)
+            else:
+                stats[g].add_num(part.to_numpy(zero_copy_only=False))
+        for g, a, b in groups:
+            st = stats[g]
+            out[g].append((c, "bool", (st.true, b - a)) if pa.types.is_boolean(t)
+                          else (c, "num", st.num()))
     return out

@@ -205,7 +205,9 @@ def _summary_text(scene, nrows, records, failed, first_error, stats, files, seco
     if failed:
         lines.append(f"WARNING: {failed} case(s) failed, e.g. {first_error}")
     if any(stats.values()):
-        lines += ["", "per surface: min / median / max [SI unit]; flags: true count"]
+        lines += ["", "per surface: min / median / max [SI unit]; flags: true count"
+                  + ("; medians from an even sample of 1e6 values per surface"
+                     if scene.n_cases > 1_000_000 else "")]
     for name, entries in stats.items():
         lines.append(f"  [{name}]")
         for c, kind, v in entries:
