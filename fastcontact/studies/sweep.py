@@ -2,25 +2,15 @@
 
 ``fastcontact sweep DB -o OUT --scene S.toml [--scheduler ADDR] [--workers N]``
 
-One Dask task per surface builds the surface's tables (only the theories the scene needs, or
-from ``cache_dir``), evaluates every case and writes ``OUT/data/part-<surface>.parquet``
-atomically (complete or absent). The driver keeps ``OUT/manifest.json`` (atomic rewrites;
-``status`` is "running", "complete", "incomplete" or "interrupted") and holds the lock
-``OUT/.sweep.lock`` while it runs.
-
-* **Resume**: rerunning the same command keeps every partition that reads back, belongs to
-  this sweep (``sweep_key``: scene, database content, table options, version) and has one
-  row per case; the rest is computed. No row is lost or duplicated, even after SIGKILL.
-* **Interrupts**: SIGINT / SIGTERM stop the cluster, mark the manifest "interrupted" and
-  raise :class:`SweepInterrupted` (exit code 130 / 143 from the CLI, one line).
-* **One sweep per folder**: a second sweep on a folder whose lock is held by a live process
-  is refused; the lock of a dead process (same host: pid gone; other host: no heartbeat for
-  :data:`LOCK_STALE_SECONDS`) is taken over.
-* **Cluster**: a ``distributed.LocalCluster`` of *spawned* worker processes (never forked),
-  one thread each (numba kernels hold the GIL; the 'workqueue' threading layer must not be
-  entered by two threads at once), the cores left to each worker given to numba
-  (``NUMBA_NUM_THREADS`` = cores // workers, ``NUMBA_THREADING_LAYER=workqueue``,
-  OMP/MKL/OpenBLAS at 1 thread). With ``scheduler=`` an existing cluster is used as is.
+One task per surface builds its tables, evaluates every case and writes
+``OUT/data/part-<surface>.parquet`` atomically (complete or absent); ``OUT/manifest.json``
+records the sweep (``status``: running, complete, incomplete, interrupted). Rerunning the same
+command resumes exactly (partitions of this ``sweep_key`` with one row per case are kept; no
+row is lost or duplicated, even after SIGKILL). SIGINT / SIGTERM stop the cluster, mark the
+manifest "interrupted" and raise :class:`SweepInterrupted` (CLI: one line, exit 130 / 143).
+``OUT/.sweep.lock`` keeps a second sweep out of a folder in use; the lock of a dead run (same
+host: pid gone; other host: no heartbeat for :data:`LOCK_STALE_SECONDS`) is taken over.
+Workers: :func:`local_cluster` (spawned processes, numba's fork-safe threading set-up).
 """
 from __future__ import annotations
 

@@ -12,12 +12,16 @@ openpyxl readers); nothing is unpickled or evaluated.
 """
 from __future__ import annotations
 
+import gzip
 import math
 import os
 import re
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
 
 from .._core.io import atomic_path
 from .._core.validate import as_float_array, check_int
@@ -126,7 +130,6 @@ def _pick(blocks, series, subject, path):
 
 
 def _read_ce_csv(path, sep, series, subject):
-    import pandas as pd
     df = pd.read_csv(path, sep=sep, comment=None)
     cols = [str(c) for c in df.columns]
     qc = next((c for c in cols if c.lower().startswith("wavevector")), None)
@@ -171,7 +174,6 @@ def _read_ce_txt(path, series, subject):
 
 
 def _read_ce_xlsx(path, series, subject):
-    import pandas as pd
     sheets = pd.read_excel(path, sheet_name=None, header=None)
     index = sheets.get("INDEX")
     if index is None:
@@ -193,7 +195,6 @@ def _read_ce_xlsx(path, series, subject):
 
 
 def _first_line(path, kind):
-    import gzip
     opener = gzip.open if kind == "csv.gz" else open
     with opener(path, "rt", encoding="utf-8", errors="replace") as fh:
         for line in fh:
@@ -240,7 +241,6 @@ def _read_table(path, kind, convention, q_col, C_col):
             raise ValueError(f"path = {path!r} is invalid: needs two columns (q, C)")
         return data[:, 0], data[:, 1], ["q", "C"]
     if kind in ("csv", "csv.gz"):
-        import pandas as pd
         try:
             df = pd.read_csv(path, comment="#", skipinitialspace=True, sep=None,
                              engine="python", compression="gzip" if kind == "csv.gz" else None)
@@ -249,7 +249,6 @@ def _read_table(path, kind, convention, q_col, C_col):
         df.columns = [str(c).strip() for c in df.columns]
         columns, get = list(df.columns), (lambda name: df[name].to_numpy())
     else:
-        import pyarrow.parquet as pq
         try:
             table = pq.read_table(path)
         except Exception as exc:  # noqa: BLE001
@@ -439,13 +438,10 @@ def write_psd(psd, path, convention="persson"):
         raise ValueError(f"path = {path!r} is invalid: folder {folder!r} does not exist")
     with atomic_path(path) as tmp:
         if kind in ("csv", "csv.gz"):
-            import pandas as pd
             pd.DataFrame({"q": q, "C": C}).to_csv(
                 tmp, index=False, float_format="%.17g",
                 compression="gzip" if kind == "csv.gz" else None)
         else:
-            import pyarrow as pa
-            import pyarrow.parquet as pq
             table = pa.table({"q": pa.array(q, pa.float64()), "C": pa.array(C, pa.float64())})
             table = table.replace_schema_metadata({
                 CONVENTION_KEY: convention.encode(),

@@ -180,11 +180,24 @@ class SelfAffinePSD(PSD):
 
     Parameters
     ----------
-    h_rms : float   rms roughness [m], > 0
-    hurst : float   Hurst exponent H, in (0, 1)
-    q0 : float      smallest wavevector [1/m], > 0
-    q1 : float      largest wavevector [1/m], > q0
-    q_roll : float, optional   roll-off wavevector [1/m], in [q0, q1); None = no roll-off
+    h_rms : float [m]
+        Root-mean-square roughness, > 0 (a length quantity, e.g. pint ``Q_(10, "um")``, is
+        converted).
+    hurst : float [-]
+        Hurst exponent H, in (0, 1).
+    q0 : float [1/m]
+        Smallest wavevector, > 0.
+    q1 : float [1/m]
+        Largest wavevector, > q0.
+    q_roll : float [1/m], optional
+        Roll-off wavevector in [q0, q1); None (default): no roll-off.
+
+    References
+    ----------
+    B.N.J. Persson, O. Albohr, U. Tartaglino, A.I. Volokitin, E. Tosatti, J. Phys.: Condens.
+    Matter 17, R1 (2005), doi:10.1088/0953-8984/17/1/R01 (self-affine spectra with roll-off);
+    B. Lorenz & B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), App. A,
+    doi:10.1140/epje/i2010-10626-9 (the convention of C).
     """
 
     def __init__(self, h_rms, hurst, q0, q1, q_roll=None):
@@ -225,11 +238,16 @@ class TabulatedPSD(PSD):
 
     Parameters
     ----------
-    q : array   wavevectors [1/m], strictly increasing, > 0, at least 2
-    C : array   spectrum at ``q`` [m^4], finite and > 0, in the stated ``convention``
+    q : array_like [1/m]
+        Wavevectors, 1-D, strictly increasing, > 0, at least 2 (a 2-D array is refused,
+        never flattened; masked elements are refused).
+    C : array_like [m^4]
+        Spectrum at ``q``, same shape, finite and > 0, in the stated ``convention``.
     convention : {"persson", "surface_topography"}
-        ``"surface_topography"`` (contact.engineering) is (2π)² times Persson's C; it is
-        converted here, and the object always holds Persson-convention C.
+        ``"surface_topography"`` (SurfaceTopography / contact.engineering) is (2π)² times
+        Persson's C (T.D.B. Jacobs, T. Junge, L. Pastewka, Surf. Topogr. Metrol. Prop. 5,
+        013001 (2017), doi:10.1088/2051-672X/aa51f8); it is converted here, and the object
+        always holds Persson-convention C.
     """
 
     def __init__(self, q, C, convention="persson"):

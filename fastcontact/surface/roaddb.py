@@ -23,6 +23,8 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
 
 from .._core.io import atomic_path
 from .._core.vocab import CONVENTIONS
@@ -42,7 +44,6 @@ MIN_SLOPE, MAX_SLOPE = 0.3, 4.0
 
 
 def _atomic_write_table(table, path: Path):
-    import pyarrow.parquet as pq
     with atomic_path(path) as tmp:
         pq.write_table(table, tmp)
     return path
@@ -113,7 +114,6 @@ def generate_road_database(path, n_surfaces, seed, *, n_q=N_Q, surfaces_per_part
 
     See :func:`synthetic_road_psd` for the distribution of the spectra.
     """
-    import pyarrow as pa
     if isinstance(n_surfaces, bool) or not isinstance(n_surfaces, (int, np.integer)) or n_surfaces < 1:
         raise ValueError(f"n_surfaces = {n_surfaces!r} is invalid: must be an integer >= 1")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -194,7 +194,6 @@ class RoadDatabase:
             raise ValueError(f"database = {str(self.path)!r} is invalid: no surfaces found")
 
     def _read_long(self, f, convention):
-        import pyarrow.parquet as pq
         try:
             table = pq.read_table(f)
         except Exception as exc:  # noqa: BLE001
@@ -244,7 +243,6 @@ class RoadDatabase:
             f = self._files[sid]
             conv = self.convention
             if conv is None and f.name.lower().endswith((".parquet", ".pq")):
-                import pyarrow.parquet as pq
                 m = (pq.read_schema(f).metadata or {}).get(CONVENTION_KEY)
                 conv = m.decode() if m is not None else None
             if conv is None:
@@ -271,7 +269,6 @@ class RoadDatabase:
 
 
 def _parquet_columns(f):
-    import pyarrow.parquet as pq
     try:
         return pq.read_schema(f).names
     except Exception:  # noqa: BLE001
