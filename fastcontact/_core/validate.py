@@ -39,6 +39,9 @@ _SI = {
     "kg": ("kg", "kg"), "W": ("W", "W"), "1/K": ("1/K", "1 / K"), "rad": ("rad", "rad"),
     "-": ("dimensionless", ""), "": ("dimensionless", ""),
 }
+#: exact types taken without further checks (bool is not among them)
+_FAST_SCALARS = frozenset({float, int, np.float64, np.float32, np.float16, np.int64, np.int32,
+                           np.int16, np.int8, np.uint64, np.uint32, np.uint16, np.uint8})
 _BRACKET = re.compile(r"\[([^\]]*)\]")
 _MAX_SHOWN = 80
 
@@ -237,7 +240,7 @@ def as_float_array(name: str, value, unit: str = "", *, allow_nan: bool = True) 
     numpy.ndarray
         float64, C-contiguous (a 0-d array for a scalar).
     """
-    if type(value) is float or type(value) is int:     # fast path: plain Python number
+    if type(value) in _FAST_SCALARS:                    # fast path: a plain real number
         arr = np.asarray(value, dtype=np.float64)
     elif type(value) is np.ndarray and value.dtype.kind in "fiu":
         arr = np.asarray(value, dtype=np.float64)

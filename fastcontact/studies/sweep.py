@@ -23,6 +23,7 @@ import os
 import re
 import signal
 import socket
+import sys
 import threading
 import time
 from pathlib import Path
@@ -450,8 +451,10 @@ def _run_locked(db, outdir, sc, ids, spectra, fingerprint, key, scheduler, worke
         f"{len(todo)} to compute")
     t0 = time.perf_counter()
     client = cluster = None
+    tty = bool(getattr(sys.stderr, "isatty", lambda: False)())
     bar = tqdm(total=len(ids), initial=len(done), unit="surface", disable=not progress,
-               desc="sweep", dynamic_ncols=True, leave=False)
+               desc="sweep", dynamic_ncols=True, leave=False, delay=2.0,
+               mininterval=0.1 if tty else 10.0)
     try:
         if todo:
             from distributed import Client
