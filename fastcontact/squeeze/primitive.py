@@ -30,7 +30,6 @@ from numba import njit, prange
 
 from .._core.io import atomic_path
 from .._core.vocab import METADATA_KEY
-from ..kernels.locate import build_bucket_map, locate_asc
 from . import _kernels as qk
 
 __all__ = ["Primitive", "load_or_build", "build", "write", "read", "set_primitive_cache",
@@ -47,22 +46,53 @@ NODE_ORDER = 6
 #: relative step of the central difference for dh/dz at the nodes
 HZ = 1e-4
 
-#: the tabulated primitive (reduced units). xn (nx) x0 nodes and their bucket locator
-#: (blo, bdz, bidx); z0, dz, nz: the z grid; L, D1, D2 (nx, nz): ln T, d ln T/dz,
+#: the tabulated primitive (reduced units). xn (nx) x0 nodes and their locator (blo, bdz,
+#: bidx: fractional row index at uniform x0 samples from blo, step bdz); z0, dz, nz: the z grid; C (nx, nz, 3): ln T, d ln T/dz,
 #: d² ln T/dz²; lnv (nx): ln v∞; lnS (nx): ln of the relaxation time in τ0; zs (nx): z of the
 #: default start; sx (nx): slope dT/d(-z) below the grid; lk (nx): ln κ, the shift of the grid
 #: variable ζ = z + ln κ (κ = (1 + (d ln σ̄/d ln v)² + (d ln π_c/d ln v)²)^½ at v∞, so that
 #: the grid resolves rows where σ̄ collapses); v_ext, c, d: closed-form tail
-Primitive = namedtuple("Primitive", "xn blo bdz bidx z0 dz nz L D1 D2 lnv lnS zs sx lk v_ext c "
-                                    "d")
+Primitive = namedtuple("Primitive", "xn blo bdz bidx z0 dz nz C lnv lnS zs sx lk v_ext c d")
 
 
 # =========================================================================== evaluation
-@njit(cache=True)
+def _index_map(xn, per_node=8):
+    """(lo, dx, fidx): the fractional row index at uniform x0 samples (O(1) row location)."""
+    k = per_node * xn.size
+    xs = np.linspace(xn[0], xn[-1], k + 1)
+    return float(xn[0]), float((xn[-1] - xn[0]) / k), np.ascontiguousarray(
+        np.interp(xs, xn, np.arange(xn.size, dtype=np.float64)))
+
+
+@njit(cache=True, inline="always")
+def _locate(pr, x):
+    """Interval j with xn[j] <= x <= xn[j+1] (-1 outside): linear estimate of the index from
+    the uniform-x map, then a short walk."""
+    xn = pr.xn
+    n = xn.size
+    if not (xn[0] <= x <= xn[n - 1]):
+        return -1
+    u = (x - pr.blo) / pr.bdz
+    c = int(u)
+    m = pr.bidx.size
+    if c > m - 2:
+        c = m - 2
+    f = pr.bidx[c] + (u - c) * (pr.bidx[c + 1] - pr.bidx[c])
+    j = int(f)
+    if j > n - 2:
+        j = n - 2
+    while j > 0 and xn[j] > x:
+        j -= 1
+    while j < n - 2 and xn[j + 1] < x:
+        j += 1
+    return j
+
+
+@njit(cache=True, inline="always")
 def stencil(pr, x0):
     """(j0, w0, w1, w2, w3): 4-point Lagrange weights of x0 over rows j0..j0+3 (j0 = -1:
     outside the rows)."""
-    j = locate_asc(x0, pr.xn, pr.blo, pr.bdz, pr.bidx)
+    j = _locate(pr, x0)
     if j < 0:
         return -1, 0.0, 0.0, 0.0, 0.0
     n = pr.xn.size
@@ -79,30 +109,30 @@ def stencil(pr, x0):
     return j0, w0, w1, w2, w3
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def row_value(arr, st):
     """Σ_r w_r arr[j0 + r] of a per-row array."""
     j0 = st[0]
     return st[1] * arr[j0] + st[2] * arr[j0 + 1] + st[3] * arr[j0 + 2] + st[4] * arr[j0 + 3]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _cell(pr, st, k):
     """Quintic Hermite coefficients (y0, d0, s0, y1, d1, s1) of the x0-combined ln T on
     z interval k."""
     j0, w0, w1, w2, w3 = st
-    L, D1, D2 = pr.L, pr.D1, pr.D2
-    y0 = w0 * L[j0, k] + w1 * L[j0 + 1, k] + w2 * L[j0 + 2, k] + w3 * L[j0 + 3, k]
-    d0 = w0 * D1[j0, k] + w1 * D1[j0 + 1, k] + w2 * D1[j0 + 2, k] + w3 * D1[j0 + 3, k]
-    s0 = w0 * D2[j0, k] + w1 * D2[j0 + 1, k] + w2 * D2[j0 + 2, k] + w3 * D2[j0 + 3, k]
+    C = pr.C
     k1 = k + 1
-    y1 = w0 * L[j0, k1] + w1 * L[j0 + 1, k1] + w2 * L[j0 + 2, k1] + w3 * L[j0 + 3, k1]
-    d1 = w0 * D1[j0, k1] + w1 * D1[j0 + 1, k1] + w2 * D1[j0 + 2, k1] + w3 * D1[j0 + 3, k1]
-    s1 = w0 * D2[j0, k1] + w1 * D2[j0 + 1, k1] + w2 * D2[j0 + 2, k1] + w3 * D2[j0 + 3, k1]
+    y0 = w0 * C[j0, k, 0] + w1 * C[j0 + 1, k, 0] + w2 * C[j0 + 2, k, 0] + w3 * C[j0 + 3, k, 0]
+    d0 = w0 * C[j0, k, 1] + w1 * C[j0 + 1, k, 1] + w2 * C[j0 + 2, k, 1] + w3 * C[j0 + 3, k, 1]
+    s0 = w0 * C[j0, k, 2] + w1 * C[j0 + 1, k, 2] + w2 * C[j0 + 2, k, 2] + w3 * C[j0 + 3, k, 2]
+    y1 = w0 * C[j0, k1, 0] + w1 * C[j0 + 1, k1, 0] + w2 * C[j0 + 2, k1, 0] + w3 * C[j0 + 3, k1, 0]
+    d1 = w0 * C[j0, k1, 1] + w1 * C[j0 + 1, k1, 1] + w2 * C[j0 + 2, k1, 1] + w3 * C[j0 + 3, k1, 1]
+    s1 = w0 * C[j0, k1, 2] + w1 * C[j0 + 1, k1, 2] + w2 * C[j0 + 2, k1, 2] + w3 * C[j0 + 3, k1, 2]
     return y0, d0, s0, y1, d1, s1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _quintic(t, h, cf):
     """(value, d/dz) of the quintic Hermite with coefficients cf at t = (z - z_k)/h."""
     y0, d0, s0, y1, d1, s1 = cf
@@ -125,13 +155,13 @@ def _quintic(t, h, cf):
     return val, der / h
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _tail_T(pr, v):
     """T at v >= v_ext: ∫_v^∞ dv'/σ̄_tail (closed form, π_c/π0 < e^-40 neglected)."""
     return qk._tail_int(pr.c, v + pr.d, math.inf)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _tail_v(pr, T):
     """Inverse of _tail_T: v with _tail_T(v) = T (T > 0)."""
     if pr.c == 0.0:
@@ -141,7 +171,7 @@ def _tail_v(pr, T):
     return math.sqrt(a2) - pr.d
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _below(pr, st):
     """(T0, h0, S) at the bottom of the z grid for the combined rows."""
     cf = _cell(pr, st, 0)
@@ -150,7 +180,7 @@ def _below(pr, st):
     return T0, -T0 * dl0, row_value(pr.sx, st)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def t_of_z(pr, st, vinf, z):
     """T(x0, v) at z = ln(v/v∞ - 1) for the stencil st of x0 (v∞ = vinf)."""
     v = vinf * (1.0 + math.exp(z))
@@ -167,7 +197,7 @@ def t_of_z(pr, st, vinf, z):
     return math.exp(_quintic(t, pr.dz, _cell(pr, st, k))[0])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def z_of_t(pr, st, vinf, T):
     """z = ln(v/v∞ - 1) with T(x0, v) = T (inverse of t_of_z; T = inf gives -inf)."""
     if T == math.inf:
@@ -194,7 +224,7 @@ def z_of_t(pr, st, vinf, T):
     hi = pr.nz - 1
     while hi - lo > 1:
         mid = (lo + hi) // 2
-        if row_value_2(pr.L, st, mid) >= lt:
+        if row_value_2(pr.C, st, mid) >= lt:
             lo = mid
         else:
             hi = mid
@@ -218,12 +248,12 @@ def z_of_t(pr, st, vinf, T):
     return pr.z0 + (lo + t) * pr.dz - lk
 
 
-@njit(cache=True)
-def row_value_2(arr2, st, k):
-    """Σ_r w_r arr2[j0 + r, k] of a per-row, per-node array."""
+@njit(cache=True, inline="always")
+def row_value_2(C, st, k):
+    """Σ_r w_r ln T[j0 + r, k] (the combined ln T at node k)."""
     j0 = st[0]
-    return (st[1] * arr2[j0, k] + st[2] * arr2[j0 + 1, k] + st[3] * arr2[j0 + 2, k]
-            + st[4] * arr2[j0 + 3, k])
+    return (st[1] * C[j0, k, 0] + st[2] * C[j0 + 1, k, 0] + st[3] * C[j0 + 2, k, 0]
+            + st[4] * C[j0 + 3, k, 0])
 
 
 # =========================================================================== build
@@ -358,10 +388,10 @@ def _panel(pf, mp, x0, vinf, za, zb, glx, glw):
 
 
 @njit(cache=True)
-def _build_row(pf, mp, x0, vinf, lk, z0, dz, glx, glw, L, D1, D2, j):
+def _build_row(pf, mp, x0, vinf, lk, z0, dz, glx, glw, C, j):
     """ln T and its z-derivatives at the ζ nodes (z = ζ - lk) of row j; returns the slope
     S below the grid."""
-    nz = L.shape[1]
+    nz = C.shape[1]
     z_ext = math.log(mp.v_ext / vinf - 1.0) if mp.v_ext > vinf else -math.inf
     z_prev = z_ext
     T_prev = qk._tail_int(mp.c, mp.v_ext + mp.d, math.inf)
@@ -374,12 +404,12 @@ def _build_row(pf, mp, x0, vinf, lk, z0, dz, glx, glw, L, D1, D2, j):
             z_prev = z
             T_prev = T
         h, dlnh = _h_dlnh(pf, mp, x0, vinf, z)
-        L[j, k] = math.log(T)
-        D1[j, k] = -h / T
-        D2[j, k] = -h * dlnh / T - (h / T) ** 2
+        C[j, k, 0] = math.log(T)
+        C[j, k, 1] = -h / T
+        C[j, k, 2] = -h * dlnh / T - (h / T) ** 2
     # slope below the grid: h(z) = S + a e^z fitted to the two lowest nodes
-    h0 = -D1[j, 0] * math.exp(L[j, 0])
-    h1 = -D1[j, 1] * math.exp(L[j, 1])
+    h0 = -C[j, 0, 1] * math.exp(C[j, 0, 0])
+    h1 = -C[j, 1, 1] * math.exp(C[j, 1, 0])
     a = (h1 - h0) / (math.exp(z0 + dz) - math.exp(z0))
     return h0 - a * math.exp(z0)
 
@@ -392,14 +422,14 @@ def _lnkappa(pf, mp, vinf):
 
 
 @njit(parallel=True, cache=True)
-def _build_kernel(pf, mp, xn, z0, dz, glx, glw, L, D1, D2, lnv, lnS, zs, sx, lk):
+def _build_kernel(pf, mp, xn, z0, dz, glx, glw, C, lnv, lnS, zs, sx, lk):
     for j in prange(xn.size):
         x0 = xn[j]
         lv = _plnv(pf, mp, x0)
         vinf = math.exp(lv)
         lnv[j] = lv
         lk[j] = _lnkappa(pf, mp, vinf)
-        sx[j] = _build_row(pf, mp, x0, vinf, lk[j], z0, dz, glx, glw, L, D1, D2, j)
+        sx[j] = _build_row(pf, mp, x0, vinf, lk[j], z0, dz, glx, glw, C, j)
         e, lm, de, dl = _pstate(pf, mp, vinf)
         lnS[j] = lv - math.log(-de) - lm  # S = v∞ |d ln v/d ln π| / σ̄(π0)
         vs = math.exp(_plnv(pf, mp, x0 + mp.lnp_start))
@@ -494,12 +524,11 @@ def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, order=NODE_ORDER, check=True):
     z_hi = math.log(mp.v_ext / math.exp(lnv_lo[0]) - 1.0) + lk_max
     nz = int(math.ceil((z_hi - z_lo) / dz)) + 2
     nx = xn.size
-    L, D1, D2 = (np.empty((nx, nz)) for _ in range(3))
+    C = np.empty((nx, nz, 3))
     lnv, lnS, zs, sx, lk = (np.empty(nx) for _ in range(5))
     glx, glw = np.polynomial.legendre.leggauss(order)
-    _build_kernel(pf, mp, xn, float(z_lo), float(dz), glx, glw, L, D1, D2, lnv, lnS, zs, sx, lk)
-    pr = Primitive(xn, *build_bucket_map(xn, ascending=True), float(z_lo), float(dz), nz, L,
-                   D1, D2, lnv, lnS, zs, sx, lk, float(mp.v_ext), float(mp.c), float(mp.d))
+    _build_kernel(pf, mp, xn, float(z_lo), float(dz), glx, glw, C, lnv, lnS, zs, sx, lk)
+    pr = Primitive(xn, *_index_map(xn), float(z_lo), float(dz), nz, C, lnv, lnS, zs, sx, lk, float(mp.v_ext), float(mp.c), float(mp.d))
     info = {"nx": int(nx), "nz": int(nz), "dxi": float(dxi), "build_seconds":
             _clock.perf_counter() - t0}
     if check:
@@ -567,8 +596,9 @@ def write(path, pr, info, model):
     cols = {"x0": pr.xn, "ln_v_inf": pr.lnv, "ln_S": pr.lnS, "z_start": pr.zs, "slope_below": pr.sx,
             "ln_kappa": pr.lk}
     arrays = {k: pa.array(v) for k, v in cols.items()}
-    for k in ("L", "D1", "D2"):
-        arrays[k] = pa.FixedSizeListArray.from_arrays(pa.array(getattr(pr, k).ravel()), nz)
+    for q, k in enumerate(("L", "D1", "D2")):
+        arrays[k] = pa.FixedSizeListArray.from_arrays(
+            pa.array(np.ascontiguousarray(pr.C[:, :, q]).ravel()), nz)
     meta = {"kind": "squeeze_time_primitive", "version": PRIMITIVE_VERSION, "key": model.key(),
             "theory": model.theory, "z0": pr.z0, "dz": pr.dz, "nz": nz, "v_ext": pr.v_ext,
             "c": pr.c, "d": pr.d, "info": info,
@@ -598,8 +628,10 @@ def read(path, expect_key=None):
     mats = {k: np.ascontiguousarray(table.column(k).combine_chunks().flatten().to_numpy()
                                     .reshape(-1, nz), dtype=np.float64) for k in ("L", "D1", "D2")}
     xn = col["x0"]
-    pr = Primitive(xn, *build_bucket_map(xn, ascending=True), float(meta["z0"]),
-                   float(meta["dz"]), nz, mats["L"], mats["D1"], mats["D2"], col["ln_v_inf"],
+    pr = Primitive(xn, *_index_map(xn), float(meta["z0"]),
+                   float(meta["dz"]), nz,
+                   np.ascontiguousarray(np.stack([mats["L"], mats["D1"], mats["D2"]], axis=2)),
+                   col["ln_v_inf"],
                    col["ln_S"], col["z_start"], col["slope_below"], col["ln_kappa"],
                    float(meta["v_ext"]),
                    float(meta["c"]), float(meta["d"]))

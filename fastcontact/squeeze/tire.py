@@ -1,4 +1,4 @@
-"""Tire tread block crossing a wet-road footprint — paper Sec. 5 (SPEC §5).
+"""Tire tread block crossing a wet-road footprint — Lorenz & Persson (2010), Sec. 5.
 
 A tread block (cylinder of radius R, effective modulus E*) enters the tire–road footprint
 (length L_f) at rolling speed v, so it spends ``t_footprint = L_f / v`` in it (0.1 m at
@@ -13,7 +13,7 @@ Pressure along the footprint — the approximation
 The nominal pressure varies along the footprint, p0(s) = p0 · f(s/L_f) with f of mean 1
 (``"uniform"``: f = 1; ``"parabolic"``: f(x) = 6x(1-x), peak 1.5 p0; or relative values at
 equally spaced stations, linearly interpolated and normalised to mean 1). The squeeze-out
-ODE (SPEC §4, eqs. 18–19) is solved at a **constant** nominal pressure p_eval for the whole
+ODE (eqs. (18)–(19)) is solved at a **constant** nominal pressure p_eval for the whole
 time in the footprint:
 
 * ``pressure_model = "mean"`` (default): p_eval = footprint mean = p0. Since a block crosses
@@ -44,18 +44,24 @@ import numpy as np
 import pandas as pd
 
 from .._core.validate import as_float_array, check_positive
+from .._core.vocab import column_name
+from . import _kernels as qk
+from .api import _check_method, attrs, run_cases, squeeze_history, squeeze_out, status_column
+from .model import squeeze_model
+from .primitive import fast_limit
+from ._fastpath import history_kernel
+from .reduced import inertia_time_constant
 
 __all__ = ["tire_footprint", "tire_history", "tire_columns", "profile_factors",
-           "pressure_profile", "PAPER_TIRE"]
+           "pressure_profile", "squeeze_method", "PAPER_TIRE"]
 
 #: the paper's Sec. 5 parameters (SI)
 PAPER_TIRE = dict(p0=0.2e6, E=10e6, R=0.02, eta=1e-3, rho=1000.0, footprint_length=0.1,
                   speed=30.0, u_start=1e-2)
 
-#: below this many distinct squeeze cases per call the per-case quadrature of squeeze_out
-#: (``method="quad"``, ~40 µs/case) beats its spline fast path, whose one-off set-up costs
-#: ~2 s per (tables, theory) plus ~0.5 s per Δu target (measured on the embedded tables)
-QUAD_BELOW = 50_000
+#: below this many cases the per-case quadrature (~20-40 µs/case) is cheaper than building
+#: the time primitive of a new (tables, theory) (~0.05-0.3 s, once; cached afterwards)
+QUAD_BELOW = 2_000
 
 
 def squeeze_method(n):
@@ -65,16 +71,25 @@ def squeeze_method(n):
 
 TIRE_BASE = ("p_eval", "p_peak", "t_footprint", "u_start", "u_inf", "t_du")
 TIRE_TAIL = ("t_star", "u_exit", "du_exit", "squeeze_complete", "trapped", "u_trap",
-             "fluid_load_fraction", "tau_inertia", "t_star_inertia", "out_of_table")
+             "fluid_load_fraction", "tau_inertia", "t_star_inertia", "out_of_table", "status")
+TIRE_UNITS = {"p_eval": "Pa", "p_peak": "Pa", "t_footprint": "s", "u_start": "m", "u_inf": "m",
+              "t_du": "s", "t_ratio": "s", "t_star": "s", "u_exit": "m", "du_exit": "m",
+              "squeeze_complete": "bool", "trapped": "bool", "u_trap": "m",
+              "fluid_load_fraction": "1", "tau_inertia": "s", "t_star_inertia": "s",
+              "out_of_table": "bool", "status": "category"}
 
 
-def _ratio_name(r):
-    return f"t_ratio_{float(r):.6g}"
+def _ratio_names(ratios):
+    names = [column_name("t_ratio", r) for r in ratios]
+    if len(set(names)) != len(names):
+        raise ValueError(f"ratios = {tuple(ratios)!r} is invalid: a ratio is requested more "
+                         f"than once (each gives one column)")
+    return names
 
 
 def tire_columns(ratios=(1.1, 1.01, 1.001)):
     """Names of the result columns of :func:`tire_footprint` for these ``ratios``."""
-    return list(TIRE_BASE) + [_ratio_name(r) for r in ratios] + list(TIRE_TAIL)
+    return list(TIRE_BASE) + _ratio_names(ratios) + list(TIRE_TAIL)
 
 
 def _profile_samples(profile):
@@ -108,176 +123,174 @@ def profile_factors(profile):
     return 1.0, float(f.max())
 
 
-def _frame_rows(df, n):
-    if len(df) != n:
-        raise RuntimeError(f"squeeze_out returned {len(df)} rows for {n} cases")
-    return df.reset_index(drop=True)
+def _inputs(p0, E_star, R, eta, footprint_length, speed, rho, u_start):
+    arrs = dict(p0=check_positive("p0", p0, "[Pa]"), E_star=check_positive("E_star", E_star, "[Pa]"),
+                R=check_positive("R", R, "[m]"), eta=check_positive("eta", eta, "[Pa·s]"),
+                footprint_length=check_positive("footprint_length", footprint_length, "[m]"),
+                speed=check_positive("speed", speed, "[m/s]"),
+                rho=check_positive("rho", rho, "[kg/m^3]"))
+    if u_start is not None:
+        arrs["u_start"] = check_positive("u_start", u_start, "[m]")
+    try:
+        shape = np.broadcast_shapes(*(np.shape(a) for a in arrs.values()))
+    except ValueError:
+        raise ValueError(f"{', '.join(arrs)} are invalid: shapes "
+                         f"{[np.shape(a) for a in arrs.values()]} do not broadcast") from None
+    return {k: np.ascontiguousarray(np.broadcast_to(a, shape).ravel(), dtype=np.float64)
+            for k, a in arrs.items()}
 
 
-def _pick(df, prefix, values):
-    """Columns of ``df`` starting with ``prefix``, one per requested value, in request order."""
-    cols = [c for c in df.columns if c.startswith(prefix)]
-    if len(cols) == len(values):
-        # verify where the suffix is a number
-        for c, v in zip(cols, values):
-            try:
-                s = float(c[len(prefix):])
-            except ValueError:
-                continue
-            if not math.isclose(s, v, rel_tol=1e-6):
-                break
-        else:
-            return cols
-    out = []
-    for v in values:
-        hit = None
-        for c in cols:
-            try:
-                if math.isclose(float(c[len(prefix):]), v, rel_tol=1e-6):
-                    hit = c
-                    break
-            except ValueError:
-                pass
-        if hit is None:
-            raise RuntimeError(f"squeeze_out returned no column {prefix}{v!r} (columns: {cols})")
-        out.append(hit)
-    return out
+def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out):
+    """The squeeze-out columns of every case in one kernel pass (ū at each case's own exit)."""
+    model = squeeze_model(tables, theory)
+    n = p_eval.size
+    us = b["u_start"] if "u_start" in b else np.full(n, np.nan)
+    cs = qk.Cases(np.ascontiguousarray(p_eval), b["E_star"], b["R"], b["eta"], us)
+    quad, _ = _check_method(method, 10, 1.0, None)
+    r = np.asarray(ratios, dtype=np.float64)
+    sq = run_cases(model, cs, r, np.array([du_complete / model.h_rms]),
+                   np.ascontiguousarray(t_fp[None, :]), method, quad)
+    out.update(u_inf=sq.u_inf, u_start=sq.u_start, t_du=sq.T[1 + r.size], t_star=sq.T[0],
+               trapped=sq.status == qk.ST_TRAPPED, u_trap=sq.u_trap, fluid_load_fraction=sq.flf,
+               out_of_table=sq.status == qk.ST_OUT, status=status_column(sq.status))
+    for k, name in enumerate(_ratio_names(ratios)):
+        out[name] = sq.T[1 + k]
+    u_exit = sq.U[0]
+    out["u_exit"] = u_exit
+    out["du_exit"] = u_exit - sq.u_inf
+    with np.errstate(invalid="ignore"):
+        out["squeeze_complete"] = (u_exit - sq.u_inf) <= du_complete
+    return model
 
 
 def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1000.0,
                    theory="average", pressure_profile="uniform", pressure_model="mean",
                    u_start=PAPER_TIRE["u_start"], du_complete=1e-6, ratios=(1.1, 1.01, 1.001),
-                   columns=None):
+                   columns=None, method=None):
     """Squeeze-out of a tread block during its passage through the footprint (Sec. 5).
 
-    Parameters (SI; the numeric ones broadcast against each other, one output row each)
+    Every case (its own pressure, speed and footprint length) costs a few interpolations of
+    the time primitive, in one parallel pass.
+
+    Parameters
     ----------
-    tables : Tables            the road surface's tables (must hold ``theory``)
-    p0 : mean nominal pressure over the footprint [Pa]
-    E_star : effective modulus of the tread rubber [Pa]
-    R : tread block radius [m] (D = 2R enters the inertia estimate)
-    eta : fluid viscosity [Pa·s] (water 1e-3; contaminated water more)
-    footprint_length : L_f [m];  speed : rolling speed v [m/s]
-    rho : fluid density [kg/m³] (inertia estimate only)
-    theory : flow-conductivity theory ("average" in the paper)
-    pressure_profile : "uniform" | "parabolic" | relative pressures at equally spaced stations
-    pressure_model : "mean" | "peak" — which constant pressure is used (module docstring)
-    u_start : initial film ū(0) [m] (None: the squeeze module's default)
-    du_complete : Δu threshold [m] for ``squeeze_complete`` and ``t_du``
-    ratios : ū/ū∞ values of the ``t_ratio_<r>`` columns
-    columns : names wanted (default all of :func:`tire_columns`); only those are computed
+    tables : Tables
+        The road surface's tables (must hold ``theory``).
+    p0 : array_like
+        Mean nominal pressure over the footprint [Pa].
+    E_star : array_like
+        Effective modulus of the tread rubber [Pa].
+    R : array_like
+        Tread block radius [m] (D = 2R enters the inertia estimate).
+    eta : array_like
+        Fluid viscosity [Pa·s] (water 1e-3).
+    footprint_length : array_like
+        Footprint length L_f [m].
+    speed : array_like
+        Rolling speed v [m/s]; the block spends t_footprint = L_f/v in the footprint.
+    rho : array_like, default 1000
+        Fluid density [kg/m³] (inertia estimate only).
+    theory : str, default "average"
+        Flow-conductivity theory.
+    pressure_profile : {"uniform", "parabolic"} or sequence, default "uniform"
+        Relative pressure along the footprint (module docstring).
+    pressure_model : {"mean", "peak"}, default "mean"
+        Which constant pressure p_eval is used.
+    u_start : array_like or None, default 0.01
+        Initial film ū(0) [m] (None: the squeeze-out default start).
+    du_complete : float, default 1e-6
+        Δu threshold [m] of ``squeeze_complete`` and ``t_du``.
+    ratios : sequence of float, default (1.1, 1.01, 1.001)
+        ū/ū∞ of the ``t_ratio_<r>`` columns.
+    columns : list of str or None
+        Columns wanted (default all of :func:`tire_columns`).
+    method : {"fast", "quad"} or None
+        Squeeze-out engine (None: :func:`squeeze_method` of the case count).
 
-    Returns a DataFrame with the requested columns (see :func:`tire_columns`).
+    Returns
+    -------
+    pandas.DataFrame
+        The requested columns (:func:`tire_columns`); ``attrs`` holds ``units``, ``theory``
+        and ``references``. ``status`` explains every NaN/inf row ("ok", "trapped",
+        "out_of_table", "start_below_equilibrium", "overflow").
     """
-    from . import squeeze_out
-    from .reduced import inertia_time_constant
-
     if pressure_model not in ("mean", "peak"):
         raise ValueError(f"pressure_model = {pressure_model!r} is invalid: must be 'mean' or 'peak'")
     _, peak = profile_factors(pressure_profile)
     du_complete = float(check_positive("du_complete", du_complete, "[m]"))
-    ratios = tuple(float(r) for r in ratios)
+    ratios = tuple(float(r) for r in np.atleast_1d(as_float_array("ratios", ratios)).ravel())
     for r in ratios:
         if not r > 1.0 or not math.isfinite(r):
             raise ValueError(f"ratios = {ratios!r} is invalid: each must be a finite number > 1")
     allc = tire_columns(ratios)
-    if columns is None:
-        columns = allc
+    columns = allc if columns is None else list(columns)
     unknown = [c for c in columns if c not in allc]
     if unknown:
         raise ValueError(f"columns = {unknown!r} is invalid: tire columns are {allc}")
     want = set(columns)
-
-    arrs = dict(p0=check_positive("p0", p0, "[Pa]"), E_star=check_positive("E_star", E_star, "[Pa]"),
-                R=check_positive("R", R, "[m]"), eta=check_positive("eta", eta, "[Pa·s]"),
-                footprint_length=check_positive("footprint_length", footprint_length, "[m]"),
-                speed=check_positive("speed", speed, "[m/s]"), rho=check_positive("rho", rho, "[kg/m^3]"))
-    if u_start is not None:
-        arrs["u_start"] = check_positive("u_start", u_start, "[m]")
-    b = dict(zip(arrs, (np.ravel(a) for a in np.broadcast_arrays(*arrs.values()))))
+    b = _inputs(p0, E_star, R, eta, footprint_length, speed, rho, u_start)
     n = b["p0"].size
     p_peak = b["p0"] * peak
     p_eval = b["p0"] if pressure_model == "mean" else p_peak
     t_fp = b["footprint_length"] / b["speed"]
     out = {"p_eval": p_eval, "p_peak": p_peak, "t_footprint": t_fp}
-
-    need_exit = bool(want & {"u_exit", "du_exit", "squeeze_complete"})
-    need_tdu = "t_du" in want
-    need_ratios = [r for r in ratios if _ratio_name(r) in want]
-    need_sq = need_exit or need_tdu or need_ratios or bool(
-        want & {"u_inf", "t_star", "trapped", "u_trap", "fluid_load_fraction", "u_start",
-                "t_star_inertia", "out_of_table"})
     u_used = b.get("u_start")
-    if need_sq:
-        # the squeeze-out depends on (p_eval, E*, R, η, ū(0)) only; the footprint time only
-        # selects where ū(t) is read: one squeeze_out call per distinct squeeze case
-        keycols = [p_eval, b["E_star"], b["R"], b["eta"]] + ([b["u_start"]] if u_start is not None else [])
-        keys = np.stack(keycols, axis=1)
-        uniq, inv = np.unique(keys, axis=0, return_inverse=True)
-        inv = inv.ravel()
-        kw = dict(p0=uniq[:, 0], E_star=uniq[:, 1], R=uniq[:, 2], eta=uniq[:, 3], theory=theory,
-                  u_start=(uniq[:, 4] if u_start is not None else None),
-                  ratios=tuple(need_ratios) if need_ratios else (1.01,),
-                  du=(du_complete,) if need_tdu else (), times=(),
-                  method=squeeze_method(len(uniq)))
-        sq = _frame_rows(squeeze_out(tables, **kw), len(uniq))
-        u_inf = sq["u_inf"].to_numpy(float)[inv]
-        out["u_inf"] = u_inf
-        u_used = sq["u_start"].to_numpy(float)[inv]
-        out["u_start"] = u_used
-        if need_tdu:
-            out["t_du"] = sq[_pick(sq, "t_du_", [du_complete])[0]].to_numpy(float)[inv]
-        for r, c in zip(need_ratios, _pick(sq, "t_ratio_", need_ratios) if need_ratios else []):
-            out[_ratio_name(r)] = sq[c].to_numpy(float)[inv]
-        out["t_star"] = sq["t_star"].to_numpy(float)[inv]
-        out["trapped"] = sq["trapped"].to_numpy(bool)[inv]
-        out["u_trap"] = sq["u_trap"].to_numpy(float)[inv]
-        out["fluid_load_fraction"] = sq["fluid_load_fraction"].to_numpy(float)[inv]
-        out["out_of_table"] = sq["out_of_table"].to_numpy(bool)[inv]
-        if need_exit:
-            # ū at the exit: one call per distinct footprint time, on the cases that have it
-            u_exit = np.full(n, np.nan)
-            for tv in np.unique(t_fp):
-                rows = np.flatnonzero(t_fp == tv)
-                cases = np.unique(inv[rows])
-                kw_t = dict(kw, p0=uniq[cases, 0], E_star=uniq[cases, 1], R=uniq[cases, 2],
-                            eta=uniq[cases, 3],
-                            u_start=(uniq[cases, 4] if u_start is not None else None),
-                            ratios=(), du=(), times=(float(tv),), method="quad")
-                st = _frame_rows(squeeze_out(tables, **kw_t), cases.size)
-                ucol = [c for c in st.columns if c.startswith("u_at_")]
-                if len(ucol) != 1:
-                    raise RuntimeError(f"squeeze_out returned u_at columns {ucol} for one time")
-                lookup = dict(zip(cases.tolist(), st[ucol[0]].to_numpy(float)))
-                u_exit[rows] = [lookup[c] for c in inv[rows].tolist()]
-            out["u_exit"] = u_exit
-            out["du_exit"] = u_exit - u_inf
-            out["squeeze_complete"] = (u_exit - u_inf) <= du_complete
+    model = None
+    if want - {"p_eval", "p_peak", "t_footprint", "tau_inertia"}:
+        if method is None:
+            method = squeeze_method(n)
+        model = _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method,
+                                 out)
+        u_used = out["u_start"]
     if want & {"tau_inertia", "t_star_inertia"}:
         tau = np.asarray(inertia_time_constant(2.0 * b["R"], b["rho"], p_eval), float) * np.ones(n)
         out["tau_inertia"] = tau
-        h = tables.h_rms
-        u0 = np.asarray(u_used if u_used is not None else np.full(n, np.nan), float) * np.ones(n)
+        u0 = u_used if u_used is not None else np.full(n, np.nan)
         with np.errstate(invalid="ignore", divide="ignore"):
-            out["t_star_inertia"] = np.where(u0 > h, tau * np.log(u0 / h), np.nan)
-    df = pd.DataFrame({c: np.asarray(out[c]) for c in columns if c in out})
-    for c in columns:
-        if c not in df:
-            df[c] = np.nan
-    return df[list(columns)]
+            out["t_star_inertia"] = np.where(u0 > tables.h_rms, tau * np.log(u0 / tables.h_rms),
+                                             np.nan)
+    df = pd.DataFrame({c: out[c] if c in out else np.full(n, np.nan) for c in columns},
+                      copy=False)
+    df.attrs["units"] = {c: TIRE_UNITS.get(c, TIRE_UNITS.get(c.rsplit("_", 1)[0], ""))
+                         for c in columns}
+    if model is not None:
+        a = attrs(model, [], method)
+        a.pop("units")
+        df.attrs.update({k: v for k, v in a.items() if k not in df.attrs})
+    return df
 
 
-def tire_history(tables, *, p0, E_star, R, eta, t, theory="average", u_start=PAPER_TIRE["u_start"]):
-    """ū(t) [m] of one tread block at constant nominal pressure ``p0`` (p_eval) over times t [s].
+def tire_history(tables, *, p0, E_star, R, eta, t, theory="average",
+                 u_start=PAPER_TIRE["u_start"]):
+    """ū(t) [m] of one tread block at constant nominal pressure ``p0`` (p_eval) over times t.
 
-    Returns a DataFrame with ``t``, ``u``, ``du`` (= ū - ū∞) and ``u_inf``.
+    Parameters
+    ----------
+    tables, p0, E_star, R, eta, theory, u_start
+        As :func:`tire_footprint`, scalars.
+    t : array_like
+        Times [s] ≥ 0.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``t`` [s], ``u`` [m], ``du`` = ū - ū∞ [m], ``u_inf`` [m]; ``attrs`` with units.
     """
-    from . import squeeze_history, squeeze_out
-    t = check_positive("t", t, "[s]", allow_zero=True).ravel()
-    h = squeeze_history(tables, p0, E_star, R, eta, theory, t, u_start=u_start)
-    u = h["u"].to_numpy(float)
-    sq = squeeze_out(tables, p0=p0, E_star=E_star, R=R, eta=eta, theory=theory, u_start=u_start,
-                     ratios=(1.01,), du=(), times=(), method="quad")
-    u_inf = float(np.ravel(sq["u_inf"].to_numpy(float))[0])
-    return pd.DataFrame({"t": h["t"].to_numpy(float) if "t" in h else t, "u": u,
-                         "du": u - u_inf, "u_inf": u_inf})
+    t = np.ascontiguousarray(check_positive("t", t, "[s]", allow_zero=True).ravel())
+    one = squeeze_out(tables, p0=p0, E_star=E_star, R=R, eta=eta, theory=theory,
+                      u_start=u_start, ratios=())
+    row = one.iloc[0]
+    u_inf = float(row["u_inf"])
+    model = squeeze_model(tables, theory)
+    x0 = math.log(float(p0) / float(E_star))
+    if row["status"] == "ok" and x0 <= fast_limit(model):
+        u = np.empty(t.size)
+        vs = math.nan if u_start is None else float(u_start) / model.h_rms
+        history_kernel(model.primitive(), x0, vs, float(row["tau0"]), model.h_rms, t, u)
+    else:
+        u = squeeze_history(tables, p0, E_star, R, eta, theory, t, u_start=u_start)["u"].to_numpy()
+    df = pd.DataFrame({"t": t, "u": u, "du": u - u_inf, "u_inf": np.full(t.size, u_inf)},
+                      copy=False)
+    df.attrs.update(one.attrs)
+    df.attrs["units"] = {"t": "s", "u": "m", "du": "m", "u_inf": "m"}
+    return df
