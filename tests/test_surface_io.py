@@ -311,3 +311,17 @@ def test_missing_extra_is_one_line():
                          timeout=120)
     assert out.stdout.strip() == ('reading topography files needs SurfaceTopography: '
                                   'pip install "fastcontact[topography]"'), out.stderr
+
+
+def test_table_header_units_converted_and_1d_refused(tmp_path):
+    q = np.geomspace(1e-2, 1e2, 6)                       # [1/µm]
+    C = 1e3 * (q / 1e-2) ** -3.6                          # [µm^4]
+    path = tmp_path / "t.csv"
+    pd.DataFrame({"q (1/um)": q, "C [um^4]": C}).to_csv(path, index=False)
+    psd = read_psd(path, "persson", q_col="q (1/um)", C_col="C [um^4]")
+    np.testing.assert_allclose(psd.q_samples, q * 1e6, rtol=1e-12)
+    np.testing.assert_allclose(psd.C_samples, C * 1e-24, rtol=1e-12)
+    one_d = tmp_path / "one.csv"
+    pd.DataFrame({"q (1/m)": q, "PSD (m³)": C}).to_csv(one_d, index=False)
+    with pytest.raises(ValueError, match=r"^C_col = 'PSD \(m³\)'.*1-D spectrum"):
+        read_psd(one_d, "persson", q_col="q (1/m)", C_col="PSD (m³)")

@@ -79,8 +79,24 @@ def _length_power(unit: str, what: str):
 
 
 def _header_unit(column: str):
-    m = re.search(r"\(([^()]*)\)\s*$", column)
+    """The unit in a column header such as ``PSD (m³)`` or ``C [um^4]``, or None."""
+    m = re.search(r"[(\[]([^()\[\]]*)[)\]]\s*$", column)
     return m.group(1) if m else None
+
+
+def _column_scale(col, want, path):
+    """SI factor of a table column from the unit in its header (1 without one); a C column
+    in length³ is a 1-D spectrum and is refused."""
+    unit = _header_unit(col)
+    if unit is None:
+        return 1.0
+    f, power = _length_power(unit, f"column {col!r}")
+    if power != want:
+        what = ("a 1-D spectrum [length³], never taken for the isotropic 2-D C [length⁴]"
+                if want == 4 and power == 3 else f"not length^{want}")
+        raise ValueError(f"C_col = {col!r} of {path!r} is invalid: {what}" if want == 4 else
+                         f"q_col = {col!r} of {path!r} is invalid: {what}")
+    return f
 
 
 # ============================================================================ contact.engineering
@@ -286,7 +302,9 @@ def read_psd(path, convention=None, *, q_col=None, C_col=None, series=None, subj
         agree. For a contact.engineering download it is known: None or
         "surface_topography".
     q_col, C_col : str, optional
-        Column names of a CSV / Parquet table (default "q" and "C").
+        Column names of a CSV / Parquet table (default "q" and "C"). A unit in the header,
+        e.g. ``"q (1/um)"``, ``"C [um^4]"``, is converted to SI; a C column in length³ (a
+        1-D spectrum) is refused.
     series : str, optional
         Series of a contact.engineering download (default "q/π × 2D PSD"). A 1-D series
         ("1D PSD along x", ...) is refused: it is never taken for the 2-D spectrum.
@@ -317,10 +335,11 @@ def read_psd(path, convention=None, *, q_col=None, C_col=None, series=None, subj
         if not isinstance(v, str) or not v:
             raise ValueError(f"{nm} = {v!r} is invalid: must be a non-empty column name")
     q, C, _ = _read_table(path, kind, convention, q_col, C_col)
+    scale = {"q": _column_scale(q_col, -1, path), "C": _column_scale(C_col, 4, path)}
     out = []
     for nm, raw in (("q", q), ("C", C)):
         try:
-            out.append(np.asarray(raw, dtype=np.float64))
+            out.append(np.asarray(raw, dtype=np.float64) * scale[nm])
         except (TypeError, ValueError):
             raise ValueError(f"{nm} = column of {path!r} is invalid: must hold numbers "
                              f"only") from None
