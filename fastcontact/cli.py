@@ -168,6 +168,8 @@ def build_parser():
     di.add_argument("path", help="road database (Parquet dataset or folder of PSD files)")
     di.add_argument("--convention", choices=("persson", "surface_topography"),
                     help="C convention of files that record none")
+    from .validation.cli import add_bem_commands  # `fastcontact bem` (issue 13)
+    add_bem_commands(sub)
     return p
 
 
@@ -426,6 +428,8 @@ def _dispatch(a):
                 "defaults": _cmd_tables_defaults}.get(a.tables_command)
     if a.command == "roaddb":
         return {"generate": _cmd_roaddb_generate, "info": _cmd_roaddb_info}.get(a.roaddb_command)
+    if a.command == "bem":
+        return getattr(a, "bem_func", None)
     return {"run": _cmd_run, "validate": _cmd_validate, "scenes": _cmd_scenes,
             "sweep": _cmd_sweep, "figures": _cmd_figures}[a.command]
 

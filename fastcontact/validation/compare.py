@@ -115,7 +115,12 @@ def read_reference(path):
     import pandas as pd
     import pyarrow.parquet as pq
 
+    import os
+
     path = str(path)
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"reference = {path!r} is invalid: no such file (write one with "
+                                f"'fastcontact bem reference' or write_reference)")
     if path.lower().endswith(".csv"):
         return pd.read_csv(path)
     table = pq.read_table(path)
