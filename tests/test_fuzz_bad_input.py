@@ -105,10 +105,9 @@ def test_seal_uniform_bad(tab, param, label):
     refused_by_name(param, lambda: seal_leak(tab, theory="critical_junction", **kw))
 
 
+# (R = None / f_N = None is the documented "not given", refused by name as "required")
 @pytest.mark.parametrize("param,label", _cases(HERTZ_OK, skip=("profile",)))
 def test_seal_hertz_bad(tab, param, label):
-    if param in ("R", "f_N") and label == "None":
-        pytest.skip("None is the documented default of an unused profile parameter")
     kw = dict(HERTZ_OK, **{param: BAD_VALUES[label]})
     refused_by_name(param, lambda: seal_leak(tab, theory="critical_junction", **kw))
 

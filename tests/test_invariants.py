@@ -44,6 +44,8 @@ OK_STATUS = ("ok", "OK", "", 0)
 #: documented "not applicable" values: column -> (kind of non-finite, flag whose FALSE value
 #: explains it). u_trap is NaN and t_trap is inf exactly when the fluid is not trapped.
 NOT_APPLICABLE = {"u_trap": ("nan", "trapped"), "t_trap": ("inf", "trapped")}
+#: input echoes that may be +inf because the input may be (squeeze_out: u_start = +inf)
+INF_INPUTS = ("u_start",)
 
 #: relative tolerances. EXACT: algebra only (rounding); ACC: the engines' stated accuracy
 #: (issue 11.5: times within 1e-6 of an independent quadrature; seal 1e-7 -> 1e-6 with margin)
@@ -98,6 +100,8 @@ def check_flags(df) -> dict:
         if v.dtype.kind != "f":
             continue
         nf = ~np.isfinite(v)
+        if c in INF_INPUTS:
+            nf &= ~np.isposinf(v)
         if c in NOT_APPLICABLE:
             kind, flag = NOT_APPLICABLE[c]
             if flag in df:
@@ -152,6 +156,7 @@ def check_squeeze(df, *, ratios=(), du=(), times=(), u_start_given=False) -> dic
     oot = df["out_of_table"].to_numpy(bool)
     u_trap = df["u_trap"].to_numpy(float)
     floor = np.where(trapped, u_trap, u_inf)
+    tau0 = df["tau0"].to_numpy(float)
     good = ~_status_bad(df) | (trapped & ~oot & np.isfinite(u_inf))
     tg = time_targets(df, ratios, du)
     neg = np.zeros(n, bool)
@@ -163,9 +168,11 @@ def check_squeeze(df, *, ratios=(), du=(), times=(), u_start_given=False) -> dic
         for c, vt in tg:
             t = df[c].to_numpy(float)
             neg |= t < 0
-            already = good & (us <= vt)
+            # at or below the target at t = 0 (outside a rounding band of 1e-13 around it)
+            already = good & (us <= vt * (1 - 1e-13))
             passed |= already & ~(t == 0.0)
-            ahead = good & (us > vt * (1 + 1e-6)) & ~(trapped & (vt <= u_trap))
+            # strictly above: a positive time (unless tau0 itself underflows: R ~ 1e-300 m)
+            ahead = good & (us > vt * (1 + 1e-6)) & ~(trapped & (vt <= u_trap)) & (tau0 > 1e-280)
             pending |= ahead & ~((t > 0) & np.isfinite(t))
             below_trap = good & trapped & (vt <= u_trap) & (us > vt)
             trap_bad |= below_trap & ~np.isposinf(t)
