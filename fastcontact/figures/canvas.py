@@ -21,8 +21,8 @@ def new_figure(layout="constrained", **kw):
     return fig
 
 
-def save_png(fig, path) -> Path:
-    """Write ``fig`` as a 150-dpi PNG atomically (temporary name, then rename)."""
+def save_png(fig, path, dpi=150) -> Path:
+    """Write ``fig`` as a PNG (``dpi`` dots per inch) atomically (temporary name, then rename)."""
     with atomic_path(path, suffix=".png.tmp") as tmp:
-        fig.savefig(tmp, format="png", dpi=150)
+        fig.savefig(tmp, format="png", dpi=dpi)
     return Path(path)

@@ -23,6 +23,10 @@ __all__ = ["make_scene_figure", "MAX_CURVES_PER_PANEL", "UNIT_LABELS"]
 #: panels show at most this many curves each; more cases are thinned evenly and the panel
 #: title says "n of m cases"
 MAX_CURVES_PER_PANEL = 60
+#: time samples per ū(t) curve (log-spaced; ~10 per decade)
+CURVE_POINTS = 100
+#: resolution of the run figures [dots per inch]
+DPI = 120
 #: display scale and unit of the case parameters in labels
 UNIT_LABELS = {"p0": (1e6, "MPa"), "E": (1e6, "MPa"), "E_star": (1e6, "MPa"),
                "E2": (1e6, "MPa"), "eta": (1e-3, "mPa s"), "R": (1e-2, "cm"),
@@ -120,7 +124,7 @@ def _curve(scene, T, row):
     u0 = float(row["u_start"]) if "u_start" in row and np.isfinite(float(row["u_start"])) else None
     return tire_curve(T, p0=_p_eval(scene, row), E_star=float(row["E_star"]), R=float(row["R"]),
                       eta=float(row["eta"]), theory=row["theory"], u_start=u0, ratios=ratios,
-                      du=du, label=_case_label(scene, row, _SQUEEZE_KEYS))
+                      du=du, label=_case_label(scene, row, _SQUEEZE_KEYS), n=CURVE_POINTS)
 
 
 def _history_figure(scene, fig_name, tables, results, path):
@@ -139,20 +143,22 @@ def _history_figure(scene, fig_name, tables, results, path):
         curves = [_curve(scene, tables[name], r) for r in rows]
         draw_tire_curves(ax, curves, quantity, t_mark,
                          "time in footprint:" if t_mark else None, labels=len(curves) <= 8)
-        shown = f" ({len(rows)} of {total} cases)" if total > len(rows) else ""
-        ax.set_title(_surface_label(scene, name) + shown, fontsize=8)
+        title = _surface_label(scene, name)
         if len(curves) > 8:
-            ax.annotate(f"{len(curves)} cases, colour: first (purple) → last (yellow) of "
-                        f"{_case_label(scene, rows[0], _SQUEEZE_KEYS) or 'the cases'} …",
-                        xy=(0.02, 0.02), xycoords="axes fraction", fontsize=6)
+            title += (f"\n{len(curves)}" + (f" of {total}" if total > len(rows) else "")
+                      + f" cases, purple → yellow: {_case_label(scene, rows[0], _SQUEEZE_KEYS)}"
+                      f" → {_case_label(scene, rows[-1], _SQUEEZE_KEYS)}")
+        elif total > len(rows):
+            title += f" ({len(rows)} of {total} cases)"
+        ax.set_title(title, fontsize=8)
     ax0 = axs[0]
     ax0.plot([], [], color="0.4", lw=0.8, ls="--",
              label=r"$\bar u/\bar u_\infty$ = 1.1, 1.01, 1.001 (- -, -., :)")
     ax0.plot([], [], color="0.4", lw=1.0, ls="-.", label=r"trapped: $\bar u_{\rm trap}$")
     if quantity == "u":
         ax0.plot([], [], color="0.4", lw=0.6, label="flat surfaces")
-    _finish(fig, axs, scene.title, legend_loc="lower left")
-    return save_png(fig, path)
+    _finish(fig, axs, scene.title, legend_loc="upper right")
+    return save_png(fig, path, dpi=DPI)
 
 
 # =========================================================================== t*(x)
@@ -182,7 +188,7 @@ def _t_star_figure(scene, results, path):
     ax.set_xlabel(f"{x} ({_SI_UNIT.get(x, '-')})")
     ax.set_ylabel(r"squeeze-out time $t^*$ (s), $\bar u(t^*) = 1.01\,\bar u_\infty$")
     _finish(fig, [ax], scene.title)
-    return save_png(fig, path)
+    return save_png(fig, path, dpi=DPI)
 
 
 # =========================================================================== seals
@@ -220,7 +226,7 @@ def _leak_figure(scene, results, path):
                                          if scene.fixed.get("profile") == "hertz" else ""))
     ax.set_ylabel(r"leak rate $Q$ (m$^3$/s)")
     _finish(fig, [ax], scene.title)
-    return save_png(fig, path)
+    return save_png(fig, path, dpi=DPI)
 
 
 def _seal_profile_kwargs(scene, row, dp):
@@ -256,7 +262,7 @@ def _profiles_figure(scene, tables, results, path):
         ax.set_title(f"{_surface_label(scene, name)}: {_case_label(scene, row) or 'first case'}",
                      fontsize=8)
     _finish(fig, axs, scene.title, legend_loc="upper center")
-    return save_png(fig, path)
+    return save_png(fig, path, dpi=DPI)
 
 
 # =========================================================================== entry

@@ -104,9 +104,13 @@ def _draw_curve(ax, c, col, quantity, label):
     ax.plot(t[ok], y[ok], color=col, lw=1.8 if label else 1.0, label=label or None)
     if c.get("trapped") and np.isfinite(level) and level > 0:
         ax.axhline(level, color=col, lw=1.0, ls="-.")
-        ax.annotate(rf"trapped: $\bar u_{{\rm trap}}$ = {c['u_trap'] * 1e6:.3g} µm",
-                    xy=(0.98, level), xycoords=("axes fraction", "data"), xytext=(0, 3),
-                    textcoords="offset points", ha="right", fontsize=7, color=col)
+        labelled = ax.__dict__.setdefault("_fastcontact_trap_levels", set())
+        key = round(math.log10(level), 2)
+        if key not in labelled:                       # one label per distinct level
+            labelled.add(key)
+            ax.annotate(rf"trapped: $\bar u_{{\rm trap}}$ = {c['u_trap'] * 1e6:.3g} µm",
+                        xy=(0.98, level), xycoords=("axes fraction", "data"), xytext=(0, 3),
+                        textcoords="offset points", ha="right", fontsize=7, color="0.15")
     styles = ("--", "-.", ":")
     for j, tr in enumerate(c["t_ratios"].values()):
         if math.isfinite(tr):
