@@ -1,6 +1,7 @@
 """Tests of fastcontact.topography: heights → C(q), spectrum files, synthetic surfaces.
 
-Physics: SPEC §1 (Persson convention, the (2π)² convention trap, Parseval, line scans).
+Physics: the Persson convention of C(q) (B. Lorenz & B.N.J. Persson, Eur. Phys. J. E 32, 281
+(2010), App. A), the (2π)² convention trap, Parseval, line scans.
 Tolerances are justified where they are set; the measured values quoted come from 20 seeds
 of the same construction (see the module doc of fastcontact.topography).
 """
@@ -56,7 +57,7 @@ def test_synthetic_heights_normalisation(sa_psd, exact_map):
     h = exact_map
     assert h.shape == (N, N) and h.dtype == np.float64
     assert abs(h.mean()) < 1e-12 * rms(h)
-    # SPEC normalisation: mean(h²) = Σ_{k≠0} C(q_k) Δq², exactly for exact amplitudes
+    # Persson normalisation: mean(h²) = Σ_{k≠0} C(q_k) Δq², exactly for exact amplitudes
     qs = 2 * math.pi * np.fft.fftfreq(N, A)
     qk = np.hypot(qs[:, None], qs[None, :])
     qk[np.abs(qk / Q_LO - 1) < 1e-9] = Q_LO
@@ -193,7 +194,7 @@ def test_n_bins_changes_resolution_not_parseval(gauss_map):
 
 # ============================================================================ line scans
 def test_abel_power_law_factor():
-    """SPEC: C = Γ(1+H)/(√π Γ(H+½)) C1D/q for C1D ∝ q^-(1+2H) — the direct inversion is exact
+    """Power law: C = Γ(1+H)/(√π Γ(H+½)) C1D/q for C1D ∝ q^-(1+2H) — the direct inversion is exact
     for a pure power law (closed-form tail)."""
     q = np.geomspace(1e4, 1e7, 31)
     for H in (0.2, 0.5, 0.8, 0.95):

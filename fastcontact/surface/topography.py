@@ -348,6 +348,12 @@ def _inputs(heights, spacing, periodic, pair):
     return heights, (spacing, spacing) if pair else spacing, bool(periodic), "array [m]"
 
 
+def _note_window(win, window, source):
+    if win is not None and window == "auto":
+        _LOG.info("psd_from_heights: non-periodic %s heights, Hann window applied (scaled to "
+                  "keep h_rms); pass periodic=True for periodic data", source)
+
+
 def _check_parseval(psd, h2):
     """RuntimeWarning when a map's spectrum misses more than PARSEVAL_WARN of its h_rms."""
     dev = psd.h_rms / math.sqrt(h2) - 1.0
@@ -428,9 +434,7 @@ def psd_from_heights(heights, spacing=None, *, n_bins=None, window="auto", perio
     n_bins = _check_n_bins(n_bins)
     check_choice("detrend", detrend, _DETRENDS)
     win = _resolve_window(window, periodic)
-    if win is not None and window == "auto":
-        _LOG.info("psd_from_heights: non-periodic %s heights, Hann window applied (scaled to "
-                  "keep h_rms); pass periodic=True for periodic data", source)
+    _note_window(win, window, source)
     if h.ndim == 1 or scans:
         rows = h[None, :] if h.ndim == 1 else h
         a = spacing if np.ndim(spacing) == 0 else spacing[1]
