@@ -1,10 +1,10 @@
-"""Slow, independent reference for seal leak rates (SPEC §6, paper eqs. 25–33).
+"""Slow, independent reference for seal leak rates (Lorenz & Persson 2010, eqs. 25–33).
 
 Built from the DIRECT contact core only (``fastcontact.conductivity.conductivity``: quadrature
-of (A1)–(A4) and the flow theories, no tables), written from SPEC §6, not from
+of (A1)–(A4) and the flow theories, no tables), written from the paper's Sec. 6, not from
 ``fastcontact.seal``. It is slow on purpose (a handful of cases per test).
 
-Uniform ring (eq. 32 with the fluid feedback, SPEC §6 closed form)::
+Uniform ring (eq. 32 with the fluid feedback, eq. 33 for uniform p0 in closed form)::
 
     Q = (L_y / L) ∫_{p0 − p_a}^{p0 − p_b} σ_eff(p) dp
 
@@ -60,7 +60,7 @@ def _gl(n):
 # --------------------------------------------------------------------------- uniform
 def uniform_reference(psd, *, p0, dp, L, L_y, E_star, eta, theory, p_b=0.0, a_perc=0.5,
                       alpha_cj=1.0, width=0.25, nodes=16, sigma=None):
-    """(Q [m³/s], relative error estimate) of a flat ring (SPEC §6 closed form).
+    """(Q [m³/s], relative error estimate) of a flat ring (closed form of eq. 33 for uniform p0).
 
     σ_eff is evaluated directly at every quadrature node, or by ``sigma(p)`` if given (e.g. a
     :class:`SigmaInterp` for the slow effective-medium theory; the integral is then cut at

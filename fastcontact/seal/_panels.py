@@ -1,0 +1,453 @@
+"""Numba kernels: the soft-seal solver for a given nominal pressure p0(x) (private).
+
+Unknown: the contact pressure c = p0 − p_f at the Gauss–Legendre nodes of adaptive panels
+on the sealing zone (:mod:`._mesh`). Discrete eq. (33) of Lorenz & Persson (2010) in the
+outlet-referenced form
+
+    F_i = (p0_i − p_b) − c_i − Δp R̃_i / W = 0,   R̃_i = ∫_{t_i}^1 r dt,  W = ∫_0^1 r dt,
+    r = (dξ/dt) / σ̄(c),
+
+solved by damped Newton (block back-substitution from the outlet, the stable direction, plus
+a Sherman–Morrison update for W). Panels whose Legendre tail of r exceeds ``tol``·W are
+halved and the solution re-converged. Leak rate per unit length: q = (Δp/W) h³E*/(12ηℓ).
+Next to percolation a failed Newton is continued in p_a from an easier problem
+(:func:`solve_robust`). ``rule`` is the flat record :class:`fastcontact.seal.context.PanelRule`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ._mesh import (array_zone, geometry, interp_series, panel_series, remaining_fraction,
+                    solve_small, zone_params)
+from ._sigma import sig_d
+
+__all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "ST_OK", "ST_NOT_REFINED",
+           "ST_NEWTON_FAILED", "ST_NO_ZONE"]
+
+#: status codes of solve_case
+ST_OK, ST_NOT_REFINED, ST_NEWTON_FAILED, ST_NO_ZONE = 0, 1, 2, 3
+
+
+@njit(cache=True)
+def _fill_nodes(kind, gp, xg, pg, m, pia, pib, zl, pan, P, n, t, xi, dxi, ea, eb):
+    for p in range(P):
+        tl = pan[p]
+        tr = pan[p + 1]
+        for k in range(n):
+            i = p * n + k
+            tt = tl + 0.5 * (tr - tl) * (zl[k] + 1.0)
+            t[i] = tt
+            xi[i], dxi[i], ea[i], eb[i] = geometry(kind, gp, xg, pg, tt, m, pia, pib)
+
+
+@njit(cache=True)
+def _resid(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, r, D, Rt, F):
+    """r = dξ/dt / σ̄(c), D = dr/dc, R̃ and F at c; returns (W, max|F|, ok).
+
+    ok is False if σ̄ = 0 somewhere (c at/after percolation: infinite resistance)."""
+    N = P * n
+    for i in range(N):
+        ci = c[i]
+        if ci <= 0.0:
+            r[i] = 0.0
+            D[i] = 0.0
+            continue
+        s, dl = sig_d(tab, sc, math.log(ci))
+        if not s > 0.0:
+            return 0.0, math.inf, False
+        r[i] = dxi[i] / s
+        D[i] = -r[i] * dl / ci
+    after = 0.0
+    for p in range(P - 1, -1, -1):
+        hh = 0.5 * (pan[p + 1] - pan[p])
+        tot = 0.0
+        for k in range(n):
+            tot += wl[k] * r[p * n + k]
+        for i in range(n):
+            acc = 0.0
+            for k in range(n):
+                acc += At[i, k] * r[p * n + k]
+            Rt[p * n + i] = after + hh * acc
+        after += hh * tot
+    W = after
+    if not W > 0.0:
+        return W, math.inf, False
+    fmax = 0.0
+    for i in range(N):
+        F[i] = eb[i] - c[i] - dpi * Rt[i] / W
+        if abs(F[i]) > fmax:
+            fmax = abs(F[i])
+    return W, fmax, True
+
+
+@njit(cache=True)
+def _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, ftol,
+            r, D, Rt, F, c2, r2, D2, Rt2, F2, y1, y2, Y, K):
+    """Damped Newton on the current mesh; c and r hold the result. Returns (W, its, ok)."""
+    N = P * n
+    W, fmax, ok = _resid(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, r, D, Rt, F)
+    if not ok:
+        return W, 0, False
+    cur = 0          # 0: current state in (c, r, D, Rt, F); 1: in the *2 arrays
+    its = 0
+    conv = False
+    while its < maxit:
+        if fmax <= ftol:
+            conv = True
+            break
+        its += 1
+        cc, rr, DD, RR, FF = (c, r, D, Rt, F) if cur == 0 else (c2, r2, D2, Rt2, F2)
+        ct, rt, Dt, Rtt, Ft = (c2, r2, D2, Rt2, F2) if cur == 0 else (c, r, D, Rt, F)
+        # B̃ y = b for b1 = -F and b2 = u = dπ R̃/W²: block back-substitution from the outlet
+        g = dpi / W
+        S1 = 0.0
+        S2 = 0.0
+        for p in range(P - 1, -1, -1):
+            hh = 0.5 * (pan[p + 1] - pan[p])
+            for i in range(n):
+                for k in range(n):
+                    K[i, k] = -g * hh * At[i, k] * DD[p * n + k]
+                K[i, i] -= 1.0
+                Y[i, 0] = -FF[p * n + i] + g * S1
+                Y[i, 1] = g * RR[p * n + i] / W + g * S2
+            if not solve_small(K, Y, n, 2):
+                return W, its, False
+            for k in range(n):
+                wk = hh * wl[k] * DD[p * n + k]
+                y1[p * n + k] = Y[k, 0]
+                y2[p * n + k] = Y[k, 1]
+                S1 += wk * Y[k, 0]
+                S2 += wk * Y[k, 1]
+        # Sherman–Morrison: δ = y1 − y2 (vᵀy1)/(1 + vᵀy2), v = w∘D
+        den = 1.0 + S2
+        if den == 0.0:
+            return W, its, False
+        fac = S1 / den
+        dmax = 0.0
+        for i in range(N):
+            y1[i] = y1[i] - y2[i] * fac
+            if abs(y1[i]) > dmax:
+                dmax = abs(y1[i])
+        lam = 1.0
+        accepted = False
+        for ls in range(24):
+            for i in range(N):
+                ct[i] = cc[i] + lam * y1[i]
+            Wt, ft, okt = _resid(tab, sc, ct, dxi, eb, dpi, pan, P, n, wl, At, rt, Dt, Rtt, Ft)
+            if okt and ft <= (1.0 - 1e-4 * lam) * fmax:
+                accepted = True
+                break
+            lam *= 0.5
+        if not accepted:
+            conv = fmax <= 1e3 * ftol      # stagnated at round-off
+            break
+        cur = 1 - cur
+        W = Wt
+        fmax = ft
+        if lam * dmax <= 1e-3 * ftol:
+            conv = True
+            break
+    if cur == 1:
+        for i in range(N):
+            c[i] = c2[i]
+            r[i] = r2[i]
+    return W, its, conv
+
+
+@njit(cache=True)
+def solve_case(tab, sc, rule, tol, maxit, kind, gp, xg, pg, pia, pib, pan_out, c_out, r_out,
+               init_P, init_pan, init_s, s_out):
+    """Solve one soft seal on its sealing zone (see the module docstring).
+
+    Returns (W, status, panels, error_estimate, newton_iterations), W = ∫ dξ/σ̄ over the
+    zone. pan_out (PMAX+1), c_out and r_out (PMAX·n) receive the final mesh and the nodal
+    contact pressure and resistance density; s_out (optional) the remaining fraction of the
+    pressure drop (p_f − p_b)/Δp at the nodes. With init_P > 0 the first mesh is init_pan and
+    the initial guess c = (p0 − p_b) − Δp·init_s at its nodes (continuation); otherwise P0
+    uniform panels and a fluid pressure linear in x. s_out is filled if it is large enough
+    (pass an empty array to skip).
+    """
+    m, n, P0, PMAX = rule.m, rule.n, rule.P0, rule.PMAX
+    zl, wl, At, Lp = rule.zl, rule.wl, rule.At, rule.Lp
+    dpi = pia - pib
+    NMAX = PMAX * n
+    t = np.empty(NMAX)
+    xi = np.empty(NMAX)
+    dxi = np.empty(NMAX)
+    ea = np.empty(NMAX)
+    eb = np.empty(NMAX)
+    c = np.empty(NMAX)
+    r = np.empty(NMAX)
+    D = np.empty(NMAX)
+    Rt = np.empty(NMAX)
+    F = np.empty(NMAX)
+    c2 = np.empty(NMAX)
+    r2 = np.empty(NMAX)
+    D2 = np.empty(NMAX)
+    Rt2 = np.empty(NMAX)
+    F2 = np.empty(NMAX)
+    y1 = np.empty(NMAX)
+    y2 = np.empty(NMAX)
+    Y = np.empty((n, 2))
+    K = np.empty((n, n))
+    Pk = np.empty(n + 1)
+    coef = np.empty((PMAX, n))
+    after = np.empty(PMAX)
+    pan = np.empty(PMAX + 1)
+    pan2 = np.empty(PMAX + 1)
+    err = np.empty(PMAX)
+    if init_P > 0:
+        P = init_P
+        for p in range(P + 1):
+            pan[p] = init_pan[p]
+    else:
+        P = P0
+        for p in range(P + 1):
+            pan[p] = p / P
+    _fill_nodes(kind, gp, xg, pg, m, pia, pib, zl, pan, P, n, t, xi, dxi, ea, eb)
+    N = P * n
+    scale = dpi
+    for i in range(N):
+        scale = max(scale, abs(eb[i]))
+    ftol = 1e-13 * scale
+    # initial guess: fluid pressure linear in ξ across the zone, capped below percolation
+    g0 = geometry(kind, gp, xg, pg, 0.0, m, pia, pib)[0]
+    g1 = geometry(kind, gp, xg, pg, 1.0, m, pia, pib)[0]
+    cperc = sc.p_perc
+    for i in range(N):
+        if init_P > 0:
+            s = init_s[i]
+        else:
+            s = (g1 - xi[i]) / (g1 - g0) if g1 > g0 else 0.5
+        ci = eb[i] - dpi * s
+        if ci > 0.9 * cperc and init_P == 0:
+            ci = 0.9 * cperc
+        c[i] = ci
+    status = ST_OK
+    total_it = 0
+    est = math.inf
+    W = 0.0
+    for rnd in range(4 * PMAX):
+        # intermediate meshes: converge loosely (the indicator needs r to ~1e-9 only)
+        W, its, conv = _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, 1e4 * ftol,
+                               r, D, Rt, F, c2, r2, D2, Rt2, F2, y1, y2, Y, K)
+        total_it += its
+        if not conv:
+            status = ST_NEWTON_FAILED
+            break
+        # error indicator per panel: Legendre tail of r, relative to W
+        panel_series(r, pan, P, n, Lp, coef, after)
+        nsplit = 0
+        est = 0.0
+        for p in range(P):
+            e = (abs(coef[p, n - 1]) + abs(coef[p, n - 2])) * (pan[p + 1] - pan[p]) / W
+            err[p] = e
+            est += e
+            if e > tol:
+                nsplit += 1
+        if nsplit == 0 or P + nsplit > PMAX:
+            if nsplit > 0:
+                status = ST_NOT_REFINED
+            # final mesh: polish to round-off
+            W, its, conv = _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, ftol,
+                                   r, D, Rt, F, c2, r2, D2, Rt2, F2, y1, y2, Y, K)
+            total_it += its
+            if not conv:
+                status = ST_NEWTON_FAILED
+            break
+        q = 0
+        for p in range(P):
+            pan2[q] = pan[p]
+            q += 1
+            if err[p] > tol:
+                pan2[q] = 0.5 * (pan[p] + pan[p + 1])
+                q += 1
+        pan2[q] = 1.0
+        Pn = q
+        # new nodes: remaining fraction s(t) of the converged solution, then c = e_b − Δπ s
+        for p in range(Pn):
+            tl = pan2[p]
+            tr = pan2[p + 1]
+            for k in range(n):
+                tt = tl + 0.5 * (tr - tl) * (zl[k] + 1.0)
+                y1[p * n + k] = remaining_fraction(tt, pan, P, n, coef, after, W, Pk)
+        for p in range(Pn + 1):
+            pan[p] = pan2[p]
+        P = Pn
+        N = P * n
+        _fill_nodes(kind, gp, xg, pg, m, pia, pib, zl, pan, P, n, t, xi, dxi, ea, eb)
+        for i in range(N):
+            c[i] = eb[i] - dpi * y1[i]
+    N = P * n
+    for p in range(P + 1):
+        pan_out[p] = pan[p]
+    for i in range(N):
+        c_out[i] = c[i]
+        r_out[i] = r[i]
+    if s_out.size >= N:
+        for i in range(N):
+            s_out[i] = (eb[i] - c[i]) / dpi
+    return W, status, P, est, total_it
+
+
+@njit(cache=True)
+def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, pan_out, c_out, r_out):
+    """solve_case, and if Newton fails from the plain initial guess (close to percolation,
+    where ln σ̄ falls by ~10³ per unit ln p), continuation in p_a: start where the peak
+    contact pressure max p0 − p_a is 0.6 p_perc (or halfway in p_a for the average theory),
+    then step the distance to percolation δ = p_perc − (max p0 − p_a) geometrically down to
+    its target, each step starting from the previous solution on the previous mesh.
+    Returns (W, status, panels, error_estimate, newton_iterations, continuation_steps)."""
+    n, PMAX, zl, Lp = rule.n, rule.PMAX, rule.zl, rule.Lp
+    gp = np.empty(3)
+    if not zone_params(kind, base, xg, pg, pia, pib, gp):
+        return 0.0, ST_NO_ZONE, 0, 0.0, 0, 0
+    nil = np.empty(0)
+    W, st, P, est, its = solve_case(tab, sc, rule, rule.tol, rule.maxit, kind, gp, xg, pg, pia,
+                                    pib, pan_out, c_out, r_out, 0, nil, nil, nil)
+    if st != ST_NEWTON_FAILED:
+        return W, st, P, est, its, 0
+    cperc = sc.p_perc
+    if cperc < math.inf:
+        dT = cperc - (pmax - pia)
+        d0 = max(dT, 0.4 * cperc, cperc - pmax + pib + 0.5 * (pia - pib))
+        if not d0 > dT:
+            return W, st, P, est, its, 0
+        pa0 = pmax - cperc + d0
+    else:
+        pa0 = pib + 0.5 * (pia - pib)
+    NMAX = PMAX * n
+    pan = np.empty(PMAX + 1)
+    sn = np.empty(NMAX)
+    cc = np.empty(NMAX)
+    rr = np.empty(NMAX)
+    zone_params(kind, base, xg, pg, pa0, pib, gp)
+    W, st, P, est, it0 = solve_case(tab, sc, rule, 1e-2, rule.maxit, kind, gp, xg, pg, pa0, pib,
+                                    pan, cc, rr, 0, pan, sn, sn)
+    its += it0
+    if st == ST_NEWTON_FAILED:
+        return W, st, P, est, its, 0
+    lam = 0.0
+    step = 0.1
+    steps = 0
+    pan_new = np.empty(PMAX + 1)
+    s_new = np.empty(NMAX)
+    r_prev = np.empty(NMAX)
+    coef = np.empty((PMAX, n))
+    after = np.empty(PMAX)
+    Pk = np.empty(n + 1)
+    for i in range(P * n):
+        r_prev[i] = rr[i]
+    W_prev = W
+    while lam < 1.0 and steps < 80 and its < 4000:
+        steps += 1
+        lt = min(1.0, lam + step)
+        if cperc < math.inf:
+            pa = pmax - cperc + d0 * (dT / d0) ** lt
+        else:
+            pa = pa0 + lt * (pia - pa0)
+        if lt == 1.0:
+            pa = pia
+        zone_params(kind, base, xg, pg, pa, pib, gp)
+        W2, st2, P2, est2, it2 = solve_case(tab, sc, rule, rule.tol, min(rule.maxit, 25), kind,
+                                            gp, xg, pg, pa, pib, pan_new, cc, rr, P, pan, sn,
+                                            s_new)
+        its += it2
+        if st2 == ST_NEWTON_FAILED:
+            # first refine the previous solution where its resistance concentrates (the peak
+            # sharpens as δ falls and the Newton needs it resolved), then shorten the step
+            panel_series(r_prev, pan, P, n, Lp, coef, after)
+            q = 0
+            for p in range(P):
+                pan_new[q] = pan[p]
+                q += 1
+                if (pan[p + 1] - pan[p]) * coef[p, 0] > 0.02 * W_prev and q < PMAX:
+                    pan_new[q] = 0.5 * (pan[p] + pan[p + 1])
+                    q += 1
+            pan_new[q] = 1.0
+            if q > P and q <= PMAX:
+                for p in range(q):
+                    tl = pan_new[p]
+                    tr = pan_new[p + 1]
+                    for k in range(n):
+                        tt = tl + 0.5 * (tr - tl) * (zl[k] + 1.0)
+                        s_new[p * n + k] = remaining_fraction(tt, pan, P, n, coef, after,
+                                                              W_prev, Pk)
+                # the previous solution on the refined mesh: its r by interpolation
+                for p in range(q):
+                    tl = pan_new[p]
+                    tr = pan_new[p + 1]
+                    for k in range(n):
+                        tt = tl + 0.5 * (tr - tl) * (zl[k] + 1.0)
+                        rr[p * n + k] = interp_series(tt, pan, P, n, coef, Pk)
+                P = q
+                for p in range(P + 1):
+                    pan[p] = pan_new[p]
+                for i in range(P * n):
+                    sn[i] = s_new[i]
+                    r_prev[i] = rr[i]
+                continue
+            step *= 0.5
+            if step < 1e-3:
+                return W2, ST_NEWTON_FAILED, P2, est2, its, steps
+            continue
+        lam = lt
+        P = P2
+        for p in range(P + 1):
+            pan[p] = pan_new[p]
+        for i in range(P * n):
+            sn[i] = s_new[i]
+            r_prev[i] = rr[i]
+        W, st, est = W2, st2, est2
+        W_prev = W
+        step = min(2.0 * step, 0.5)
+    if lam < 1.0:
+        return W, ST_NEWTON_FAILED, P, est, its, steps
+    for p in range(P + 1):
+        pan_out[p] = pan[p]
+    for i in range(P * n):
+        c_out[i] = cc[i]
+        r_out[i] = rr[i]
+    return W, st, P, est, its, steps
+
+
+@njit(cache=True)
+def solve_row(tab, sc, rule, kind, xg, p0n, amp, pia, pib, out, i, pan, cc, rr):
+    """Row i of a batch into ``out`` (flat record of arrays W, status, panels, err, xs, xe).
+
+    kind 0, Hertz: amp = π_H (p0n unused); kind 1, array: p0 = p0n·amp at ξ = xg (p0n [Pa],
+    amp = 1/E*). Reduced π_a, π_b. W = ∫dξ/σ̄ over the sealing zone; pan / rr receive the
+    final mesh and resistance density (for the profile evaluation). Returns the panel count."""
+    if kind == 0:
+        base1 = np.empty(1)
+        base1[0] = amp
+        W, st, P, est, its, cs = solve_robust(tab, sc, rule, 0, base1, xg, p0n, amp, pia, pib,
+                                              pan, cc, rr)
+        out.xs[i] = math.nan
+        out.xe[i] = math.nan
+    else:
+        pg = p0n * amp
+        xs, xe = array_zone(xg, pg, pia, pib)
+        out.xs[i] = xs
+        out.xe[i] = xe
+        W, st, P, est, its, cs = solve_robust(tab, sc, rule, 1, pg, xg, pg, pg.max(), pia, pib,
+                                              pan, cc, rr)
+    out.W[i] = W
+    out.status[i] = st
+    out.panels[i] = P
+    out.err[i] = est
+    return P
+
+
+@njit(cache=True, parallel=True)
+def solve_rows(tab, sc, rule, kind, xg, p0n, amp, pia, pib, rows, out):
+    """Soft seals of the rows listed in ``rows`` (parallel; see :func:`solve_row`)."""
+    for j in prange(rows.size):
+        i = rows[j]
+        pan = np.empty(rule.PMAX + 1)
+        cc = np.empty(rule.PMAX * rule.n)
+        rr = np.empty(rule.PMAX * rule.n)
+        solve_row(tab, sc, rule, kind, xg, p0n, amp[i], pia[i], pib[i], out, i, pan, cc, rr)
