@@ -15,12 +15,16 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from reference.ext_anisotropy import p_of_u, sigma_fixed, sigma_self_consistent  # noqa: E402
+from reference.ext_anisotropy import p_of_u, sigma_fixed, sigma_self_consistent
 
-import fastcontact as fc  # noqa: E402
-from fastcontact.flow.anisotropy import (directional_sigma_bar, directional_threshold,  # noqa: E402
-                                         precompute_directional, sigma_directional)
-from fastcontact.flow.conductivity import conductivity  # noqa: E402
+import fastcontact as fc
+from fastcontact.flow.anisotropy import (
+    directional_sigma_bar,
+    directional_threshold,
+    precompute_directional,
+    sigma_directional,
+)
+from fastcontact.flow.conductivity import conductivity
 
 E_STAR = 1e7
 
@@ -98,3 +102,13 @@ def test_table_path(psd):
     assert tab.sigma_bar(1.0001 * pc, E_STAR, "x") == 0.0
     np.testing.assert_allclose(tab.conductivity(1e5, E_STAR, 2e-3, "y"),
                                tab.sigma_bar(1e5, E_STAR, "y") * psd.h_rms ** 3 / (12 * 2e-3))
+
+    # the same as ordinary Tables: every engine runs the anisotropic case unchanged
+    tx = directional_tables(tables, 3.0, "x", directional=tab)
+    assert tx.options["anisotropy"] == 3.0 and tx.options["direction"] == "x"
+    np.testing.assert_allclose(tx.sigma_bar(p, E_STAR, "emt"), sx, rtol=3e-5)
+    ty = directional_tables(tables, 3.0, "y", directional=tab)
+    np.testing.assert_allclose(ty.sigma_bar(p, E_STAR, "emt"), sy, rtol=3e-5)
+    sq = fc.squeeze_out(tx, p0=1e5, E_star=E_STAR, R=0.01, eta=1e-3, theory="emt")
+    sq_iso = fc.squeeze_out(tables, p0=1e5, E_star=E_STAR, R=0.01, eta=1e-3, theory="emt")
+    assert sq.t_star[0] < sq_iso.t_star[0]        # easier flow along the grooves

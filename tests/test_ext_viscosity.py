@@ -14,15 +14,23 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from reference.ext_reynolds import (barus, hertz_shoot, radial_mean_pressure,  # noqa: E402
-                                    seal_bvp, squeeze_time)
+from reference.ext_reynolds import (
+    barus,
+    hertz_shoot,
+    radial_mean_pressure,
+    seal_bvp,
+    squeeze_time,
+)
 
-import fastcontact as fc  # noqa: E402
-from fastcontact.seal import seal_leak  # noqa: E402
-from fastcontact.seal.viscosity import seal_leak_piezo  # noqa: E402
-from fastcontact.squeeze import squeeze_out  # noqa: E402
-from fastcontact.squeeze.viscosity import (barus_mean_pressure, barus_rate_factor,  # noqa: E402
-                                           squeeze_out_piezo)
+import fastcontact as fc
+from fastcontact.seal import seal_leak
+from fastcontact.seal.viscosity import seal_leak_piezo
+from fastcontact.squeeze import squeeze_out
+from fastcontact.squeeze.viscosity import (
+    barus_mean_pressure,
+    barus_rate_factor,
+    squeeze_out_piezo,
+)
 
 E_STAR = 1e7
 ETA = 1e-3
@@ -119,6 +127,12 @@ def test_seal_uniform(tables, theory):
     zero = seal_leak_piezo(tables, p0=p0, dp=dp, L=L, L_y=L_Y, E_star=E_STAR, eta=ETA,
                            alpha_pv=0.0, theory=theory)
     np.testing.assert_allclose(zero.Q, base.Q, rtol=1e-9)
+    if theory == "critical_junction":                   # σ ∝ α_cj³ carried exactly
+        b54 = seal_leak(tables, p0=p0, dp=dp, L=L, L_y=L_Y, E_star=E_STAR, eta=ETA,
+                        theory=theory, alpha_cj=0.54)
+        z54 = seal_leak_piezo(tables, p0=p0, dp=dp, L=L, L_y=L_Y, E_star=E_STAR, eta=ETA,
+                              alpha_pv=0.0, theory=theory, alpha_cj=0.54)
+        np.testing.assert_allclose(z54.Q, b54.Q, rtol=1e-9)
     for d, al in [(2e4, 3e-5), (4.5e4, 3e-5)]:
         q, _ = seal_bvp(_sigma(tables, theory), lambda x: p0 + 0 * x, 0.0, L, d, 0.0, al)
         got = seal_leak_piezo(tables, p0=p0, dp=d, L=L, L_y=L_Y, E_star=E_STAR, eta=ETA,

@@ -44,8 +44,15 @@ from ..kernels.quadrature import gauss_legendre
 from ..kernels.special import k_table
 from .conductivity import check_theory, conductivity
 
-__all__ = ["sigma_directional", "directional_sigma_bar", "DirectionalTable",
-           "precompute_directional", "FORMS", "N_PANELS"]
+__all__ = [
+    "FORMS",
+    "N_PANELS",
+    "DirectionalTable",
+    "directional_sigma_bar",
+    "precompute_directional",
+    "directional_tables",
+    "sigma_directional",
+]
 
 FORMS = ("self_consistent", "fixed")
 #: composite Gauss–Legendre panels (order 10) in the graded variable t of A (see Notes)
@@ -76,8 +83,7 @@ def _solve_dir(W, sig, A1, lam):
         return 0.0
     smax = 0.0
     for j in range(sig.size):
-        if sig[j] > smax:
-            smax = sig[j]
+        smax = max(smax, sig[j])
     lo = -700.0
     hi = math.log(smax) + 2.0 + math.log(1.0 + 1.0 / lam)
     y = 0.5 * (lo + hi)
@@ -379,3 +385,49 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
                      "anisotropy": g, "form": form, "n_panels": int(n_panels),
                      "build_seconds": time.perf_counter() - t0})
     return tab
+
+
+def directional_tables(tables, anisotropy, direction="x", *, form="self_consistent",
+                       directional=None, n_panels=N_PANELS):
+    """A :class:`~fastcontact.tables.Tables` whose "emt" conductivity is σ_xx or σ_yy.
+
+    Every engine that reads tables (``squeeze_out``, ``seal_leak``, ``tire_footprint``, the
+    Barus engines) then runs the anisotropic case unchanged. The "emt" columns (σ̄ and its
+    first and second ln-derivatives, φ_p, percolated) are replaced on the tables' own nodes
+    from the spline of :func:`precompute_directional` (built here unless ``directional`` is
+    given); "average" is kept (it carries no direction), other theories are dropped. The
+    choice is recorded in ``options`` (``anisotropy``, ``direction``, ``anisotropy_form``)
+    and so in the Parquet provenance.
+    """
+    from ..tables import Tables
+
+    if "emt" not in tables.theories:
+        raise ValueError(f"tables = {tables!r} is invalid for directional_tables: they must "
+                         f"hold the 'emt' theory")
+    g = _check("emt", anisotropy, direction, form)
+    d = directional or precompute_directional(tables, g, form=form, n_panels=n_panels)
+    if d.anisotropy != g or d.form != form:
+        raise ValueError(f"directional = {d!r} is invalid: built for γ_T = {d.anisotropy}, "
+                         f"form = {d.form!r}, not {g}, {form!r}")
+    lnp = np.log(np.asarray(tables.data["p_over_E"], dtype=np.float64))
+    spl, n_open = d._spl[direction]
+    last = d.lnp[n_open - 1]
+    sig = d.sigma_bar(np.exp(lnp), 1.0, direction)
+    inside = (lnp <= last) & (sig > 0)
+    keep = [t for t in tables.theories if t in ("average", "emt")]
+    drop = [t for t in tables.theories if t not in keep]
+    data = {k: v for k, v in tables.data.items()
+            if not any(k.endswith("_" + t) for t in drop) and k not in ("zeta_c", "u1c_over_h")}
+    data["sigma_emt"] = np.ascontiguousarray(sig)
+    data["dlnsigma_emt"] = np.ascontiguousarray(np.where(inside, spl(lnp, 1), 0.0))
+    data["d2lnsigma_emt"] = np.ascontiguousarray(np.where(inside, spl(lnp, 2), 0.0))
+    data["phi_emt"] = np.ascontiguousarray(sig / np.asarray(tables.data["u_over_h"]) ** 3)
+    data["percolated_emt"] = lnp >= d.lnp_perc[direction]
+    info = dict(tables.info)
+    perc = dict(info.get("percolation_p_over_E", {}))
+    perc = {k: v for k, v in perc.items() if k in keep}
+    perc["emt"] = math.exp(d.lnp_perc[direction])
+    info["percolation_p_over_E"] = perc
+    info["directional"] = {k: v for k, v in d.info.items()}
+    options = dict(tables.options, anisotropy=g, direction=direction, anisotropy_form=form)
+    return Tables(tables.surface, keep, options, tables.grid, tables.zeta_grid, data, info)

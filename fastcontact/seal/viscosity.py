@@ -29,7 +29,7 @@ from numba import njit, prange
 from .._core.validate import check_positive
 from ..tables import k_sigma_of_lnp
 
-__all__ = ["seal_leak_piezo", "TAIL_CUT", "HERTZ_STEPS"]
+__all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
 
 #: the uniform-ring quadrature starts TAIL_CUT below ln(p_cont_min/E*) of the table (integrand ∝ p_cont)
 TAIL_CUT = 60.0
@@ -58,8 +58,7 @@ def _uniform_integral(tab, sc, E, p0, pa, pb, alpha, glx, glw, width):
         xa = sc[0] - TAIL_CUT
     else:
         xa = math.log((p0 - pa) / E)
-        if xa < sc[0] - TAIL_CUT:
-            xa = sc[0] - TAIL_CUT
+        xa = max(xa, sc[0] - TAIL_CUT)
     if not xb > xa:
         return 0.0
     m = max(1, int(math.ceil((xb - xa) / width)))
@@ -198,7 +197,7 @@ def _scalars(tables, theory):
 
 
 def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_junction",
-                    p_b=0.0, profile="uniform", p0=None, L=None, R=None, f_N=None,
+                    alpha_cj=1.0, p_b=0.0, profile="uniform", p0=None, L=None, R=None, f_N=None,
                     quad_order=10, quad_width=0.5, steps=HERTZ_STEPS):
     """Leak rate Q [m³/s] of a seal with a Barus fluid, uniform ring or Hertz O-ring.
 
@@ -218,6 +217,9 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         Pressure–viscosity coefficient α [1/Pa], >= 0; η = η0 exp(α (p_f - p_b)).
     theory : str
         Flow theory of σ_eff (must be in the tables).
+    alpha_cj : float
+        Critical-junction factor [-]: σ ∝ α_cj³, so Q is rescaled by (α_cj/α_table)³
+        exactly (q is linear in σ in both profiles); ignored by the other theories.
     p_b : array_like
         Outlet gauge pressure [Pa], >= 0.
     profile : {"uniform", "hertz"}
@@ -301,7 +303,11 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
             kq[run] = k
             conv[run] = ok
         cols.update({"R": g1, "f_N": g2, "a": a, "p_max": pH})
-    Q = L_y * kq * h ** 3 / (12.0 * eta)
+    scale = 1.0
+    if theory == "critical_junction":
+        a_cj = float(check_positive("alpha_cj", alpha_cj, "[-]"))
+        scale = (a_cj / float(tables.options.get("alpha_cj", 1.0))) ** 3
+    Q = scale * L_y * kq * h ** 3 / (12.0 * eta)
     Q = np.where(lift, math.inf, np.where(conv & ~out_t, Q, math.nan))
     cols.update({"p_a": pa, "Q": Q, "lift_off": lift, "percolated": perc, "converged": conv,
                  "out_of_table": out_t})

@@ -40,7 +40,7 @@ from ..contact import area_fraction
 from ..tables import precompute
 from . import squeeze_out
 
-__all__ = ["region_radius", "asperity_levels", "plot_asperity_tstar", "TIRE_CASE"]
+__all__ = ["TIRE_CASE", "asperity_levels", "plot_asperity_tstar", "region_radius"]
 
 #: the paper's Sec. 5 tread block: R = 2 cm, p0 = 0.2 MPa, E = 10 MPa (ν = 0.5), water
 TIRE_CASE = dict(R=0.02, p0=0.2e6, E_star=10e6 / 0.75, eta=1e-3)
@@ -112,7 +112,7 @@ def asperity_levels(psd, *, p0, E_star, R, eta, theory="emt", level_ratio=2.0, z
         raise ValueError(f"zetas = {zs.tolist()!r} is invalid: must ascend from 1 and stay "
                          f"below ζ1 = {psd.zeta1:g}")
     region = region_radius if region is None else region
-    a_perc = _A_PERC[theory] if theory in _A_PERC else 0.5
+    a_perc = _A_PERC.get(theory, 0.5)
     G1 = psd.moment(3.0, psd.q0, psd.q1)
     rows = []
     for z in zs:

@@ -30,10 +30,16 @@ import pandas as pd
 from numba import njit, prange
 
 from .._core.validate import check_positive
+from .._core.vocab import column_name
 from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
+from .api import register_extension, squeeze_out
 
-__all__ = ["barus_mean_pressure", "barus_rate_factor", "squeeze_out_piezo",
-           "DEFAULT_P_START"]
+__all__ = [
+    "DEFAULT_P_START",
+    "barus_mean_pressure",
+    "barus_rate_factor",
+    "squeeze_out_piezo",
+]
 
 #: default start, as in :func:`fastcontact.squeeze.squeeze_out`: p_cont(u_start) = 1e-3 p0
 DEFAULT_P_START = 1e-3
@@ -154,8 +160,7 @@ def _integrand(tab, sc, x0, api, vinf, w):
     if not (sig > 0.0):
         return math.inf
     d = -math.expm1(lnp - x0)
-    if d <= 1e-300:
-        d = 1e-300
+    d = max(1e-300, d)
     g = _rate_factor(api * d) if api > 0.0 else 1.0
     return e / (sig * d * g)
 
@@ -346,9 +351,9 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory="average",
     cols = {"p0": flat[0], "E_star": flat[1], "R": flat[2], "eta": flat[3],
             "alpha_pv": flat[4], "u_start": ustart, "u_inf": uinf, "t_star": T[0]}
     for k, r in enumerate(ratios):
-        cols[f"t_ratio_{r:g}"] = T[1 + k]
+        cols[column_name("t_ratio", r)] = T[1 + k]
     for k, d in enumerate(du):
-        cols[f"t_du_{d:g}"] = T[1 + ratios.size + k]
+        cols[column_name("t_du", d)] = T[1 + ratios.size + k]
     cols.update({"tau0": tau0, "barus_number": flat[4] * flat[0], "rate_factor_start": gs,
                  "piezo_limit": status == ST_PIEZO, "trapped": status == ST_TRAPPED,
                  "out_of_table": status == ST_OUT})
@@ -363,3 +368,25 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory="average",
                      "references": ["doi:10.2475/ajs.s3-45.266.87",
                                     "doi:10.1140/epje/i2010-10628-1"]})
     return df
+
+
+# =========================================================================== hook
+def _squeeze_hook(tables, kw, alpha_pv):
+    """``squeeze_out(..., alpha_pv=α)``: α = 0 everywhere → the base engine (unchanged
+    output); otherwise :func:`squeeze_out_piezo` (no ``times``/``u_at`` columns)."""
+    a = check_positive("alpha_pv", alpha_pv, "[1/Pa]", allow_zero=True)
+    rest = {k: v for k, v in kw.items() if k != "alpha_pv"}
+    if not np.any(a):
+        return squeeze_out(tables, **rest)
+    if np.size(rest.get("times", ())):
+        raise ValueError("times = ... is invalid with alpha_pv > 0: the Barus engine returns "
+                         "target times only (use ratios / du)")
+    return squeeze_out_piezo(tables, p0=rest["p0"], E_star=rest["E_star"], R=rest["R"],
+                             eta=rest["eta"], alpha_pv=a, theory=rest.get("theory", "average"),
+                             u_start=rest.get("u_start"), ratios=rest.get("ratios", (1.1, 1.01, 1.001)),
+                             du=rest.get("du", ()), quad_order=rest.get("quad_order", 10),
+                             quad_width=rest.get("quad_width", 1.0),
+                             sigma_trap=rest.get("sigma_trap"))
+
+
+register_extension("alpha_pv", _squeeze_hook)

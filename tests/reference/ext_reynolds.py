@@ -43,13 +43,12 @@ def radial_mean_pressure(K, visc_ratio, rtol=1e-12):
 def squeeze_time(tables, theory, p0, E_star, R, eta, alpha, u_a, u_b, u_inf, rtol=1e-9):
     """Time [s] from ū = u_a down to u_b (> u_inf) for a Barus fluid, from the Reynolds ODE."""
     visc = barus(alpha)
-    h = tables.h_rms
 
     def rate(u):
         pc = float(tables.contact_pressure(u, E_star))
         pf = p0 - pc
         sig = float(tables.conductivity(pc, E_star, eta, theory))
-        g = lambda lk: radial_mean_pressure(math.exp(lk), visc) - pf  # noqa: E731
+        g = lambda lk: radial_mean_pressure(math.exp(lk), visc) - pf
         lo, hi = math.log(pf) - 1.0, math.log(pf) + 1.0
         while g(lo) > 0:
             lo -= 2.0
@@ -109,7 +108,7 @@ def hertz_shoot(sigma0, pH, a, p_a, p_b, alpha, rtol=1e-11):
             return [-k * math.sin(th) * math.exp(alpha * (y[0] * pH - p_b)) * s_ref
                     / float(sigma0(np.atleast_1d(pc))[0])]
 
-        stop = lambda th, y: y[0] + 5.0  # noqa: E731
+        stop = lambda th, y: y[0] + 5.0
         stop.terminal = True
         sol = integrate.solve_ivp(f, (th_s, th_e), [p_a / pH], method="DOP853", rtol=rtol,
                                   atol=1e-13, events=stop)
