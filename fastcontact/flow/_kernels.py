@@ -11,6 +11,7 @@ B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 31, 159 (2010), doi:10.1140/epje/i
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -18,8 +19,43 @@ from numba import njit, prange
 from ..contact._kernels import m1_above, u1_at_area
 from ..kernels.quadrature import gauss_kronrod15
 
-__all__ = ["critical_junction_kernel", "emt_kernel", "emt_sigma", "bruggeman", "EMT_TOL",
-           "EMT_MAX_PANELS", "EMT_GRADE"]
+__all__ = ["EMTSpec", "critical_junction_kernel", "emt_kernel", "emt_sigma", "bruggeman",
+           "EMT_TOL", "EMT_MAX_PANELS", "EMT_GRADE"]
+
+
+class EMTSpec(NamedTuple):
+    """Flat settings of the effective-medium integral (passes into prange kernels as it is).
+
+    Attributes
+    ----------
+    h_rms : float
+        rms roughness [m] (σ̄ is reduced by h_rms³).
+    gamma : float
+        Yang–Persson factor of u1 [-].
+    glx, glw : ndarray
+        Gauss–Legendre rule of the (A4) panels.
+    panel : float
+        Panel width in τ of the (A4) quadrature.
+    almqvist : bool
+        Gaussian-broadened P(u) (Almqvist et al. 2011).
+    ghx, ghw : ndarray
+        Gauss–Hermite rule of the broadening.
+    n_start : int
+        Initial Gauss–Kronrod panels.
+    tol : float
+        Target relative accuracy of σ̄ [-].
+    """
+
+    h_rms: float
+    gamma: float
+    glx: np.ndarray
+    glw: np.ndarray
+    panel: float
+    almqvist: bool
+    ghx: np.ndarray
+    ghw: np.ndarray
+    n_start: int
+    tol: float
 
 
 @njit(cache=True)
@@ -129,9 +165,9 @@ def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw, guess=0.0):
 
 
 @njit(cache=True)
-def _emt_fill_panel(sk, pbar, A1, t0, t1, h_rms, gamma, ktab, glx, glw, panel, almqvist, work,
-                    sig, hz, WK, WG, off):
+def _emt_fill_panel(sk, pbar, A1, t0, t1, ktab, spec, work, sig, hz, WK, WG, off):
     """u1-based σ(u) at the 15 Kronrod nodes of panel [t0, t1] of the graded variable t."""
+    h_rms = spec.h_rms
     m = EMT_GRADE
     half = 0.5 * (t1 - t0)
     mid = 0.5 * (t1 + t0)
@@ -148,21 +184,26 @@ def _emt_fill_panel(sk, pbar, A1, t0, t1, h_rms, gamma, ktab, glx, glw, panel, a
             sig[off + k] = math.inf
             hz[off + k] = 0.0
             continue
-        u, a = u1_at_area(sk, area, pbar, gamma, ktab, glx, glw, panel, work)
+        u, a = u1_at_area(sk, area, pbar, spec.gamma, ktab, spec.glx, spec.glw, spec.panel, work)
         if not (u < math.inf) or u != u:
             sig[off + k] = math.inf  # masked: dA/dζ = 0 there
         else:
             uh = max(u, 0.0) / h_rms
             sig[off + k] = uh * uh * uh
-        hz[off + k] = math.sqrt(2.0 * math.pi * m1_above(sk.qb, sk.c, sk.e, a)) / h_rms if almqvist else 0.0
+        if spec.almqvist:
+            hz[off + k] = math.sqrt(2.0 * math.pi * m1_above(sk.qb, sk.c, sk.e, a)) / h_rms
+        else:
+            hz[off + k] = 0.0
 
 
 @njit(cache=True)
-def emt_sigma(sk, pbar, h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx, ghw, n_start, tol):
+def emt_sigma(sk, pbar, ktab, spec):
     """Bruggeman σ̄ at one reduced pressure with adaptive Gauss–Kronrod panels in A.
 
+    ``sk`` a PSDKernel, ``ktab`` the K(s0) tables, ``spec`` an :class:`EMTSpec`.
     Returns (σ̄, estimated relative error, number of u1 evaluations).
     """
+    almqvist, ghx, ghw, tol = spec.almqvist, spec.ghx, spec.ghw, spec.tol
     A1 = _area1(sk.cum3, pbar)
     if A1 >= 0.5:
         return 0.0, 0.0, 0
@@ -174,12 +215,11 @@ def emt_sigma(sk, pbar, h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx, ghw,
     pt0 = np.empty(EMT_MAX_PANELS)
     pt1 = np.empty(EMT_MAX_PANELS)
     work = np.empty(4)
-    npan = n_start
+    npan = spec.n_start
     for k in range(npan):
         pt0[k] = k / npan
         pt1[k] = (k + 1) / npan
-        _emt_fill_panel(sk, pbar, A1, pt0[k], pt1[k], h_rms, gamma, ktab, glx, glw, panel,
-                        almqvist, work, sig, hz, WK, WG, 15 * k)
+        _emt_fill_panel(sk, pbar, A1, pt0[k], pt1[k], ktab, spec, work, sig, hz, WK, WG, 15 * k)
     s = 0.0
     est = 0.0
     while True:
@@ -213,23 +253,19 @@ def emt_sigma(sk, pbar, h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx, ghw,
         a1 = pt1[worst]
         am = 0.5 * (a0 + a1)
         pt1[worst] = am
-        _emt_fill_panel(sk, pbar, A1, a0, am, h_rms, gamma, ktab, glx, glw, panel, almqvist,
-                        work, sig, hz, WK, WG, 15 * worst)
+        _emt_fill_panel(sk, pbar, A1, a0, am, ktab, spec, work, sig, hz, WK, WG, 15 * worst)
         pt0[npan] = am
         pt1[npan] = a1
-        _emt_fill_panel(sk, pbar, A1, am, a1, h_rms, gamma, ktab, glx, glw, panel, almqvist,
-                        work, sig, hz, WK, WG, 15 * npan)
+        _emt_fill_panel(sk, pbar, A1, am, a1, ktab, spec, work, sig, hz, WK, WG, 15 * npan)
         npan += 1
 
 
 @njit(cache=True, parallel=True)
-def emt_kernel(sk, pbar, h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx, ghw, n_start, tol,
-               sigma, percolated, err, nevals):
-    """Bruggeman σ̄ = 12ησ_eff/h_rms³ per reduced pressure (u1-based P(u))."""
+def emt_kernel(sk, pbar, ktab, spec, sigma, percolated, err, nevals):
+    """Bruggeman σ̄ = 12ησ_eff/h_rms³ per reduced pressure (u1-based P(u)) into the out arrays."""
     for i in prange(pbar.size):
         percolated[i] = _area1(sk.cum3, pbar[i]) >= 0.5
-        s, es, ne = emt_sigma(sk, pbar[i], h_rms, gamma, ktab, glx, glw, panel, almqvist, ghx,
-                              ghw, n_start, tol)
+        s, es, ne = emt_sigma(sk, pbar[i], ktab, spec)
         sigma[i] = s
         err[i] = es
         nevals[i] = ne

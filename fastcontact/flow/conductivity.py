@@ -27,7 +27,7 @@ from ..contact import _check_gamma, _check_psd, _separation, mean_separation
 from ..contact._kernels import PANEL, psd_kernel
 from ..kernels.quadrature import gauss_hermite, gauss_legendre
 from ..kernels.special import k_table
-from ._kernels import EMT_TOL, critical_junction_kernel, emt_kernel
+from ._kernels import EMT_TOL, EMTSpec, critical_junction_kernel, emt_kernel
 
 __all__ = ["THEORIES", "EMT_TOL", "check_theory", "conductivity", "flow_factor", "sigma_bar",
            "SigmaBar", "SigmaDetails", "Conductivity", "FlowFactor"]
@@ -148,9 +148,10 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
     sig = np.empty(pbar.size)
     err = np.empty(pbar.size)
     nev = np.empty(pbar.size, dtype=np.int64)
+    spec = EMTSpec(float(h), float(gamma), glx, glw, float(panel), bool(almqvist), ghx, ghw,
+                   int(n_start), float(tol))
     with _dynamic_schedule():
-        emt_kernel(sk, pbar, h, gamma, k_table(), glx, glw, float(panel), bool(almqvist), ghx,
-                   ghw, int(n_start), float(tol), sig, perc, err, nev)
+        emt_kernel(sk, pbar, k_table(), spec, sig, perc, err, nev)
     return SigmaBar(sig, perc, SigmaDetails(error_estimate=err, u1_evaluations=nev))
 
 
