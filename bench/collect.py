@@ -11,7 +11,9 @@ import os
 from pathlib import Path
 
 HERE = Path(__file__).parent
-ORDER = ["tables", "squeeze", "seal", "sweep"]
+ORDER = ["tables", "squeeze", "seal", "sweep", "run_memory", "fuzz", "extensions"]
+#: fragments whose script name differs from bench_<name>.py
+SCRIPT = {"run_memory": "bench_run_memory.py"}
 HEADER = """# fastcontact benchmark results
 
 Numbers are produced by the scripts in `bench/` (each section names its script). Machines are
@@ -25,7 +27,8 @@ def main():
     for name in ORDER:
         frag = HERE / f"{name}_results.md"
         if frag.exists():
-            parts.append(f"<!-- from bench/{frag.name} (bench/bench_{name}.py) -->\n" + frag.read_text())
+            parts.append(f"<!-- from bench/{frag.name} (bench/{SCRIPT.get(name, f'bench_{name}.py')}) -->\n"
+                         + frag.read_text())
         else:
             parts.append(f"## {name}\n\nNot yet measured: run `python bench/bench_{name}.py`.\n")
     out = HERE / "RESULTS.md"
