@@ -6,7 +6,8 @@ q_r = 4 q0, q1 = 32 q0), E* = 10 MPa, η = 1 mPa·s; pressures where Persson's A
 grid convergence from seed 0 at n = 128 (every H) and n = 512 (H = 0.7). Writes bench/VALIDATION.md,
 bench/validation_errors.png, bench/validation_constants.png and bench/validation_*.parquet.
 
-Run: python bench/bench_validation.py   (about 10 min on 2 idle cores)
+Run: python bench/bench_validation.py   (measured: 2625 s of stage wall time at load ~13 on 2
+     cores shared with other jobs; the CPU time is several times smaller — idle not measured)
      python bench/bench_validation.py --H 0.7      one surface (run several in parallel), then
      python bench/bench_validation.py --collect    comparisons, figures and VALIDATION.md
      (FASTCONTACT_BENCH_REUSE=1 reuses a saved validation_ref_H*.parquet)
