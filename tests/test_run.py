@@ -93,7 +93,7 @@ def test_every_column_carries_its_unit(tmp_path):
     units = {f.name: (f.metadata or {}).get(b"unit", b"?").decode() for f in schema}
     assert units["p0"] == "Pa" and units["eta"] == "Pa s" and units["R"] == "m"
     assert units["u_inf"] == "m" and units["t_star"] == "s" and units["t_ratio_1.1"] == "s"
-    assert units["t_du_1e-06"] == "s" and units["trapped"] == "" and units["nu"] == "1"
+    assert units["t_du_1e-06"] == "s" and units["trapped"] == "bool" and units["nu"] == "1"
     assert set(units) == set(schema.names)
     meta = json.loads(schema.metadata[b"fastcontact"])
     assert meta["units"] == units

@@ -15,22 +15,27 @@ import numpy as np
 
 from .._core.vocab import column_name
 from ..seal import seal_leak
+from ..squeeze import columns as squeeze_engine_columns
 from ..squeeze import squeeze_out
+from ..squeeze.api import units_of as squeeze_units
 from ..squeeze.tire import squeeze_method, tire_columns, tire_footprint
 
 __all__ = ["StudyKind", "KINDS", "BOOL_COLUMNS", "SQUEEZE_TAIL", "SEAL_COLUMNS",
            "SEAL_HERTZ_COLUMNS", "squeeze_columns", "available_columns", "column_units"]
 
-#: further squeeze_out columns offered by squeeze studies
-SQUEEZE_TAIL = ("tau0", "t_relax", "trapped", "percolated", "u_trap", "t_trap",
-                "fluid_load_fraction", "out_of_table")
+#: the squeeze_out inputs it echoes (the cases hold them already)
+_SQUEEZE_INPUTS = ("p0", "E_star", "R", "eta")
+#: further squeeze_out columns offered by squeeze studies (as the engine lists them)
+SQUEEZE_TAIL = tuple(c for c in squeeze_engine_columns((), (), ())
+                     if c not in _SQUEEZE_INPUTS + ("u_start", "u_inf", "t_star"))
 SEAL_COLUMNS = ("Q", "lift_off", "percolated", "p_a", "open_inlet", "open_outlet")
 SEAL_HERTZ_COLUMNS = ("a", "L", "p_max", "converged", "error_estimate")
 #: boolean result columns (nullable booleans where a case failed)
 BOOL_COLUMNS = frozenset({"trapped", "percolated", "out_of_table", "squeeze_complete",
                           "lift_off", "converged"})
-#: SI unit of every fixed-name result column ("1": dimensionless, "": flag or text)
-_UNITS = {
+#: SI unit of every fixed-name result column ("1": dimensionless, "bool": flag, "category":
+#: status text; the squeeze engine's own units take precedence)
+_UNITS = {**{c: "bool" for c in BOOL_COLUMNS}, "status": "category",
     "u_start": "m", "u_inf": "m", "t_star": "s", "tau0": "s", "t_relax": "s", "u_trap": "m",
     "t_trap": "s", "fluid_load_fraction": "1", "p_eval": "Pa", "p_peak": "Pa",
     "t_footprint": "s", "t_du": "s", "u_exit": "m", "du_exit": "m", "tau_inertia": "s",
@@ -113,10 +118,8 @@ def _out_of_table_errors(tables, rows, oot):
 
 # =========================================================================== squeeze
 def squeeze_columns(ratios, du, times) -> list:
-    """Result columns of a squeeze study (``column_name`` spelling of every target)."""
-    return (["u_start", "u_inf", "t_star"] + [column_name("t_ratio", r) for r in ratios]
-            + [column_name("t_du", d) for d in du] + [column_name("u_at", t) for t in times]
-            + list(SQUEEZE_TAIL))
+    """Result columns of a squeeze study: the engine's catalogue without the inputs it echoes."""
+    return [c for c in squeeze_engine_columns(ratios, du, times) if c not in _SQUEEZE_INPUTS]
 
 
 def _squeeze_infer(axes, fixed, given, problems):
