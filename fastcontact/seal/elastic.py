@@ -71,38 +71,121 @@ def seal_elastic(tables, *, R, f_N, dp, L_y, E_star, eta, theory="critical_junct
     fN = scalar("f_N", check_positive("f_N", f_N, "[N/m]"))
     n = int(check_range("n", n, 8, 5000, "[-] (panels)"))
     gap = float(check_positive("gap", gap, "[-] (multiples of h_rms)"))
-    E, eta_, dpv, pb = com["E_star"], com["eta"], com["dp"], com["p_b"]
+    if x_extent is not None:
+        x_extent = float(scalar("x_extent", check_positive("x_extent", x_extent, "[m]")))
     sc = seal_context(tables, theory)
-    h = sc.h_rms
-    a, pH = (float(v) for v in hertz_contact(Rv, fN, E))
-    if x_extent is None:
-        target = gap * h / (a * a / (2 * Rv))
-        if _hertz_gap(3.0) <= target:
-            X = 3.0 * a
-        else:
-            X = a * brentq(lambda z: _hertz_gap(z) - target, 1.0, 3.0, xtol=1e-14)
+    pr = _ElasticProblem(sc, Rv, fN, com["E_star"], com["p_b"], n, gap, x_extent)
+    v, v_c = pr.dry_start(tables)
+    dpv = com["dp"]
+    if steps is not None:
+        nsteps = int(steps)
     else:
-        X = float(scalar("x_extent", check_positive("x_extent", x_extent, "[m]")))
-    d = 2 * X / n
-    xc = -X + d * (np.arange(n) + 0.5)
-    K = _log_kernel(xc, d)
-    Ke = (2.0 / (math.pi * E * h)) * K            # (per h_rms) displacement per Pa
-    xq = xc * xc / (2 * Rv * h)
-    phz = pH * np.sqrt(np.clip(1.0 - (xc / a) ** 2, 0.0, 1.0))
+        nsteps = 1 if dpv == 0 else max(2, int(math.ceil(6 * dpv / pr.pH)))
+    its, converged, lifted, st = 0, True, False, None
+    for k in (range(1, nsteps + 1) if dpv > 0 else [0]):
+        dpk = dpv * k / nsteps if dpv > 0 else 0.0
+        prev = (v.copy(), v_c, st)
+        ok, v, v_c, st, it = pr.newton(v, v_c, dpk, tol, max_iter)
+        its += it
+        if st is None:                          # left the table: keep the last good step
+            v, v_c, st = prev
+            converged = False
+            break
+        if not ok:
+            # a failure right after a step that left the contact nearly unloaded is lift-off
+            if prev[2] is not None and pr.d * prev[2][2].sum() / fN < 0.05:
+                v, v_c, st = prev
+                lifted = True
+            else:
+                converged = False
+            break
+        if pr.d * st[2].sum() / fN < 1e-3:       # the contact carries nothing: lifted off
+            lifted = True
+            break
     scale = float(alpha_scale(sc, theory, np.array([alpha]))[0])
-    lnp = np.empty(n)
-    dlnp = np.empty(n)
-    sg = np.empty(n)
-    dls = np.empty(n)
+    return _elastic_frame(pr, com, theory, scale, v, v_c, st, converged, lifted, its)
 
-    M = np.tril(np.ones((n, n)), -1) + 0.5 * np.eye(n)   # cumulative midpoint rule
-    KeM = Ke @ M                                          # once: the flow part is rank-structured
 
-    def state(v, dpk):
-        _sigma.contact_of_u(sc.tab, sc.rec, np.ascontiguousarray(v), lnp, dlnp, sg, dls)
+def _elastic_frame(pr, com, theory, scale, v, v_c, st, converged, lifted, its):
+    """The result DataFrame of :func:`seal_elastic` from the final state."""
+    if st is None:
+        raise ValueError("seal_elastic: the dry start lies outside the tables (contact pressure "
+                         "above their top); reduce f_N or use tables reaching higher pressures")
+    G, J, pc, pf, p0, W, perc = st
+    pr._contact(v)                                  # σ̄ of the kept state
+    h, eta_, pb = pr.h, com["eta"], com["p_b"]
+    frac = float(pr.d * pc.sum() / pr.fN)
+    lift = bool(lifted or (converged and frac < 1e-3))
+    if perc:
+        Q = 0.0
+    elif lift:
+        Q = math.inf                       # the contact no longer carries the load: open
+    else:
+        Q = com["L_y"] * com["dp"] * h ** 3 / (12.0 * eta_ * W) * scale
+    sig = pr.sg * scale * h ** 3 / (12.0 * eta_)
+    df = pd.DataFrame({"x": pr.xc + pr.X, "x_center": pr.xc, "p0": p0, "p_cont": pc,
+                       "p_fluid": pf, "p_hertz": pr.phz, "u": v * h, "sigma_eff": sig})
+    df.attrs.update({"Q": float(Q) if (converged or lift) else math.nan, "u_c": float(v_c * h),
+                     "converged": bool(converged), "iterations": its, "percolated": bool(perc),
+                     "lift_off": lift,
+                     "contact_load_fraction": frac, "X": pr.X, "a": pr.a, "p_hertz_max": pr.pH,
+                     "dp_reached": float(pf[0] - pb) if np.isfinite(pf[0]) else math.nan,
+                     "theory": theory, "profile": "elastic", "references": list(REFERENCES),
+                     "units": {"x": "m", "x_center": "m", "p0": "Pa", "p_cont": "Pa",
+                               "p_fluid": "Pa", "p_hertz": "Pa", "u": "m",
+                               "sigma_eff": "m^3/(Pa s)", "Q": "m^3/s", "u_c": "m"}})
+    return df
+
+
+class _ElasticProblem:
+    """Panels, kernels and the Newton residual of one stiff seal (eqs. 27–30)."""
+
+    def __init__(self, sc, R, fN, E, pb, n, gap, x_extent):
+        self.sc, self.R, self.fN, self.E, self.pb, self.n = sc, R, fN, E, pb, n
+        h = self.h = sc.h_rms
+        a, pH = (float(v) for v in hertz_contact(R, fN, E))
+        self.a, self.pH = a, pH
+        if x_extent is None:
+            target = gap * h / (a * a / (2 * R))
+            if _hertz_gap(3.0) <= target:
+                X = 3.0 * a
+            else:
+                X = a * brentq(lambda z: _hertz_gap(z) - target, 1.0, 3.0, xtol=1e-14)
+        else:
+            X = x_extent
+        self.X = X
+        d = self.d = 2 * X / n
+        xc = self.xc = -X + d * (np.arange(n) + 0.5)
+        self.Ke = (2.0 / (math.pi * E * h)) * _log_kernel(xc, d)   # per h_rms, per Pa
+        self.xq = xc * xc / (2 * R * h)
+        self.phz = pH * np.sqrt(np.clip(1.0 - (xc / a) ** 2, 0.0, 1.0))
+        self.lnp, self.dlnp, self.sg, self.dls = (np.empty(n) for _ in range(4))
+        self.M = np.tril(np.ones((n, n)), -1) + 0.5 * np.eye(n)   # cumulative midpoint rule
+        self.KeM = self.Ke @ self.M                      # once: the flow part is rank-structured
+
+    def _contact(self, v):
+        _sigma.contact_of_u(self.sc.tab, self.sc.rec, np.ascontiguousarray(v), self.lnp,
+                            self.dlnp, self.sg, self.dls)
+
+    def dry_start(self, tables):
+        """Dry Hertz start: rough-contact separation at the Hertz pressure plus the Hertz gap."""
+        h, a, n = self.h, self.a, self.n
+        pg = np.maximum(self.phz, 1e-4 * self.pH)
+        v = np.asarray(tables.mean_separation(pg, self.E), dtype=float).reshape(n) / h
+        out_ = np.abs(self.xc) > a
+        v[out_] += _hertz_gap(np.abs(self.xc[out_]) / a) * a * a / (2 * self.R * h)
+        self._contact(v)
+        p0g = self.E * np.exp(self.lnp) + self.pb
+        return v, float(np.mean(v - self.xq + self.Ke @ p0g))
+
+    def state(self, v, v_c, dpk):
+        """(G, J, p_cont, p_f, p0, W, percolated) at (ū/h, u_c/h), or None off the table."""
+        n, d, Ke, pb = self.n, self.d, self.Ke, self.pb
+        self._contact(v)
+        lnp, dlnp, sg, dls = self.lnp, self.dlnp, self.sg, self.dls
         if not np.all(np.isfinite(lnp)):
             return None
-        pc = E * np.exp(lnp)
+        pc = self.E * np.exp(lnp)
         blocked = ~(sg > 0)
         J = np.empty((n + 1, n + 1))
         if blocked.any():
@@ -121,99 +204,45 @@ def seal_elastic(tables, *, R, f_N, dp, L_y, E_star, eta, theory="critical_junct
             # ∂p_f/∂v = −dp (M/W − S 1ᵀ/W²) diag(∂ρ/∂v)
             KS = Ke @ S
             J[:n, :n] = (np.eye(n) + Ke * (pc * dlnp)[None, :]
-                         - dpk * (KeM / W - KS[:, None] / W ** 2) * drho[None, :])
-            colsum = pc * dlnp - dpk * (M.sum(axis=0) / W - S.sum() / W ** 2) * drho
+                         - dpk * (self.KeM / W - KS[:, None] / W ** 2) * drho[None, :])
+            colsum = pc * dlnp - dpk * (self.M.sum(axis=0) / W - S.sum() / W ** 2) * drho
         p0 = pc + pf
         G = np.empty(n + 1)
-        G[:n] = v - v_c[0] - xq + Ke @ p0
-        G[n] = (d * p0.sum() - fN) / fN * 10.0
+        G[:n] = v - v_c - self.xq + Ke @ p0
+        G[n] = (d * p0.sum() - self.fN) / self.fN * 10.0
         J[:n, n] = -1.0
-        J[n, :n] = d * colsum / fN * 10.0
+        J[n, :n] = d * colsum / self.fN * 10.0
         J[n, n] = 0.0
         return G, J, pc, pf, p0, W, blocked.any()
 
-    # dry Hertz start: rough-contact separation at the Hertz pressure plus the Hertz gap
-    pg = np.maximum(phz, 1e-4 * pH)
-    v = np.asarray(tables.mean_separation(pg, E), dtype=float).reshape(n) / h
-    out_ = np.abs(xc) > a
-    v[out_] += _hertz_gap(np.abs(xc[out_]) / a) * a * a / (2 * Rv * h)
-    v_c = np.zeros(1)
-    _sigma.contact_of_u(sc.tab, sc.rec, np.ascontiguousarray(v), lnp, dlnp, sg, dls)
-    p0g = E * np.exp(lnp) + pb
-    v_c[0] = float(np.mean(v - xq + Ke @ p0g))
-    if steps is not None:
-        nsteps = int(steps)
-    else:
-        nsteps = 1 if dpv == 0 else max(2, int(math.ceil(6 * dpv / pH)))
-    its = 0
-    converged = True
-    lifted = False
-    st = None
-    for k in (range(1, nsteps + 1) if dpv > 0 else [0]):
-        dpk = dpv * k / nsteps if dpv > 0 else 0.0
-        prev = (v.copy(), v_c[0], st)
-        st = state(v, dpk)
+    def newton(self, v, v_c, dpk, tol, max_iter):
+        """Damped Newton at fluid pressure difference dpk: (ok, v, v_c, state, iterations)."""
+        n = self.n
+        st = self.state(v, v_c, dpk)
         if st is None:
-            converged = False
-            break
-        ok = False
-        for it in range(max_iter):
-            G, J, pc, pf, p0, W, perc = st
-            gn = np.max(np.abs(G))
+            return False, v, v_c, None, 0
+        its = 0
+        for _ in range(max_iter):
+            gn = np.max(np.abs(st[0]))
             if gn < tol * max(1.0, np.max(np.abs(v))):
-                ok = True
-                break
+                return True, v, v_c, st, its
             its += 1
             try:
-                delta = np.linalg.solve(J, -G)
+                delta = np.linalg.solve(st[1], -st[0])
             except np.linalg.LinAlgError:
-                break
+                return False, v, v_c, st, its
             lam = 1.0
             acc = False
             while lam > 1e-6:
                 vt = v + lam * delta[:n]
                 if np.all(vt > 0):
-                    vc0 = v_c[0]
-                    v_c[0] = vc0 + lam * delta[n]
-                    stt = state(vt, dpk)
+                    vct = v_c + lam * delta[n]
+                    stt = self.state(vt, vct, dpk)
                     if stt is not None and np.max(np.abs(stt[0])) < (1 - 1e-4 * lam) * gn:
-                        v, st, acc = vt, stt, True
+                        v, v_c, st, acc = vt, vct, stt, True
                         break
-                    v_c[0] = vc0
                 lam *= 0.5
             if not acc:
-                ok = gn < 1e3 * tol * max(1.0, np.max(np.abs(v)))
-                break
-        if not ok:
-            # a failure right after a step that left the contact nearly unloaded is lift-off
-            if prev[2] is not None and d * prev[2][2].sum() / fN < 0.05:
-                v, v_c[0], st = prev[0], prev[1], prev[2]
-                lifted = True
-            else:
-                converged = False
-            break
-        if d * st[2].sum() / fN < 1e-3:          # the contact carries nothing: lifted off
-            lifted = True
-            break
-    G, J, pc, pf, p0, W, perc = st
-    frac = float(d * pc.sum() / fN)
-    lift = bool(lifted or (converged and frac < 1e-3))
-    if perc:
-        Q = 0.0
-    elif lift:
-        Q = math.inf                       # the contact no longer carries the load: open
-    else:
-        Q = com["L_y"] * dpv * h ** 3 / (12.0 * eta_ * W) * scale
-    sig = sg * scale * h ** 3 / (12.0 * eta_)
-    df = pd.DataFrame({"x": xc + X, "x_center": xc, "p0": p0, "p_cont": pc, "p_fluid": pf,
-                       "p_hertz": phz, "u": v * h, "sigma_eff": sig})
-    df.attrs.update({"Q": float(Q) if (converged or lift) else math.nan, "u_c": float(v_c[0] * h),
-                     "converged": bool(converged), "iterations": its, "percolated": bool(perc),
-                     "lift_off": lift,
-                     "contact_load_fraction": frac, "X": X, "a": a, "p_hertz_max": pH,
-                     "dp_reached": float(pf[0] - pb) if np.isfinite(pf[0]) else math.nan,
-                     "theory": theory, "profile": "elastic", "references": list(REFERENCES),
-                     "units": {"x": "m", "x_center": "m", "p0": "Pa", "p_cont": "Pa",
-                               "p_fluid": "Pa", "p_hertz": "Pa", "u": "m",
-                               "sigma_eff": "m^3/(Pa s)", "Q": "m^3/s", "u_c": "m"}})
-    return df
+                self.state(v, v_c, dpk)        # restore the work arrays of the kept state
+                return gn < 1e3 * tol * max(1.0, np.max(np.abs(v))), v, v_c, st, its
+        return False, v, v_c, st, its
