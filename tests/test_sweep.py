@@ -225,8 +225,10 @@ def _wait_for_partitions(proc, out, n, timeout=240):
 @pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
                          ids=["SIGINT", "SIGTERM"])
 def test_signal_ends_sweep_cleanly_and_resume_is_exact(setup, tmp_path, sig, code):
-    """A real signal delivered to the CLI process (not its workers): one line on stderr, exit
-    130 / 143, manifest "interrupted", lock released; the rerun completes exactly."""
+    """A real signal — SIGINT to the whole process group as a terminal's Ctrl-C sends it
+    (workers included), SIGTERM to the CLI process — gives one line on stderr and no worker
+    traceback, exit 130 / 143, manifest "interrupted", lock released; the rerun completes
+    exactly."""
     base, db, scene, clean, man = setup
     out = tmp_path / "sig"
     cmd = [sys.executable, "-m", "fastcontact.cli", "sweep", str(db), "-o", str(out),
@@ -236,7 +238,10 @@ def test_signal_ends_sweep_cleanly_and_resume_is_exact(setup, tmp_path, sig, cod
     try:
         k = _wait_for_partitions(proc, out, 2)
         assert proc.poll() is None and 0 < k < 14, f"{k} partitions"
-        proc.send_signal(sig)
+        if sig == signal.SIGINT:
+            os.killpg(proc.pid, sig)            # a terminal's Ctrl-C: the whole process group
+        else:
+            proc.send_signal(sig)               # `kill PID`: the driver only
         stdout, stderr = proc.communicate(timeout=120)
     finally:
         if proc.poll() is None:

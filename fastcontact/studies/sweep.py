@@ -252,6 +252,14 @@ def _interrupts():
 
 
 # ============================================================================ cluster
+def dask_setup(worker):
+    """Worker preload of :func:`local_cluster`: a terminal's Ctrl-C reaches the whole process
+    group; the driver handles it (and stops the workers), so the workers ignore SIGINT
+    instead of printing a KeyboardInterrupt traceback each."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def local_cluster(workers=None):
     """A ``distributed.LocalCluster`` set up for fastcontact's numba kernels.
 
@@ -270,7 +278,8 @@ def local_cluster(workers=None):
     numba_threads = max(1, cores // n)
     env = worker_environment(numba_threads)
     with dask.config.set({"distributed.worker.multiprocessing-method": "spawn",
-                          "distributed.worker.daemon": False}):
+                          "distributed.worker.daemon": False,
+                          "distributed.worker.preload": [__name__]}):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                dashboard_address=None, env=env, silence_logs=logging.ERROR)
     return cluster, {"local_workers": n, "threads_per_worker": 1,
@@ -470,9 +479,10 @@ def _run_locked(db, outdir, sc, ids, spectra, fingerprint, key, scheduler, worke
         _finish(manifest, done, ids, todo, t0, status="interrupted")
         manifest["interrupted_by"] = str(exc)
         write_json_atomic(mpath, manifest)
+        on_disk = len(list((outdir / DATA_DIR).glob("part-*.parquet")))
         raise SweepInterrupted(
-            f"sweep interrupted by {exc}: {len(done)}/{len(ids)} surfaces complete in "
-            f"{outdir}; rerun the same command to resume", exc.exit_code) from None
+            f"sweep interrupted by {exc}: {max(on_disk, len(done))}/{len(ids)} surfaces complete "
+            f"in {outdir}; rerun the same command to resume", exc.exit_code) from None
     finally:
         bar.close()
         with contextlib.suppress(Exception), _ignore_signals():
