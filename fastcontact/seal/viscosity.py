@@ -234,7 +234,9 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
     pandas.DataFrame
         ``Q`` [m³/s] (inf beyond lift-off, 0 if percolated or dp = 0), ``lift_off``,
         ``percolated``, ``converged`` (Hertz shooting), ``out_of_table`` (the largest
-        contact pressure lies beyond the tables: Q = NaN), and the inputs.
+        contact pressure lies beyond the tables: Q = NaN), ``status`` ("ok", "lift_off"
+        (p_a = max p0: finite limit), "open" (Q = inf), "percolated", "above_table",
+        "not_converged"), and the inputs.
     """
     from ..tables import Tables
     if not isinstance(tables, Tables):
@@ -309,8 +311,11 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         scale = (a_cj / float(tables.options.get("alpha_cj", 1.0))) ** 3
     Q = scale * L_y * kq * h ** 3 / (12.0 * eta)
     Q = np.where(lift, math.inf, np.where(conv & ~out_t, Q, math.nan))
-    cols.update({"p_a": pa, "Q": Q, "lift_off": lift, "percolated": perc, "converged": conv,
-                 "out_of_table": out_t})
+    pmax = p0v if profile == "uniform" else pH
+    status = np.select([lift, pa == pmax, perc, out_t, ~conv],
+                       ["open", "lift_off", "percolated", "above_table", "not_converged"], "ok")
+    cols.update({"p_a": pa, "Q": Q, "lift_off": lift | (pa == pmax), "percolated": perc,
+                 "converged": conv, "out_of_table": out_t, "status": status})
     df = pd.DataFrame(cols, copy=False)
     df.attrs.update({"units": {"Q": "m^3/s", "dp": "Pa", "p_a": "Pa", "p_b": "Pa", "p0": "Pa",
                                "L": "m", "L_y": "m", "E_star": "Pa", "eta": "Pa s",

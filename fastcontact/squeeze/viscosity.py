@@ -299,7 +299,8 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory="average",
         Inputs, ``u_start``, ``u_inf`` [m], ``t_star`` (ū = 1.01 ū∞) and target times [s],
         ``tau0`` [s], ``barus_number`` = α p0 [-], ``rate_factor_start`` g at the start [-],
         flags ``piezo_limit`` (α(p0 - p_cont) >= 1 at the start: NaN times), ``trapped``
-        (p0 beyond the trap pressure: targets below ū_trap take inf), ``out_of_table``.
+        (p0 beyond the trap pressure: targets below ū_trap take inf), ``out_of_table``,
+        ``status`` ("ok", "trapped", "out_of_table", "piezo_limit").
 
     Notes
     -----
@@ -356,7 +357,8 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory="average",
         cols[column_name("t_du", d)] = T[1 + ratios.size + k]
     cols.update({"tau0": tau0, "barus_number": flat[4] * flat[0], "rate_factor_start": gs,
                  "piezo_limit": status == ST_PIEZO, "trapped": status == ST_TRAPPED,
-                 "out_of_table": status == ST_OUT})
+                 "out_of_table": status == ST_OUT,
+                 "status": np.array(["ok", "trapped", "out_of_table", "piezo_limit"])[status]})
     df = pd.DataFrame(cols, copy=False)
     units = {"p0": "Pa", "E_star": "Pa", "R": "m", "eta": "Pa s", "alpha_pv": "1/Pa",
              "u_start": "m", "u_inf": "m", "tau0": "s", "barus_number": "1",
