@@ -165,3 +165,16 @@ def test_seal_flags(tables):
     with pytest.raises(ValueError, match="alpha_pv"):
         seal_leak_piezo(tables, p0=5e4, dp=1e3, L=5e-3, L_y=L_Y, E_star=E_STAR, eta=ETA,
                         alpha_pv=float("nan"))
+
+
+def test_squeeze_out_keyword(tables):
+    """squeeze_out(..., alpha_pv=) dispatches: 0 → the base engine unchanged, > 0 → Barus."""
+    kw = dict(p0=np.array([1e5, 4e5]), E_star=E_STAR, R=0.01, eta=ETA, theory="emt")
+    base = squeeze_out(tables, **kw)
+    zero = squeeze_out(tables, alpha_pv=0.0, **kw)
+    assert base.equals(zero)
+    got = squeeze_out(tables, alpha_pv=2e-6, **kw)
+    ref = squeeze_out_piezo(tables, alpha_pv=2e-6, **kw)
+    assert got.equals(ref)
+    with pytest.raises(ValueError, match="times"):
+        squeeze_out(tables, alpha_pv=2e-6, times=(1e-3,), **kw)
