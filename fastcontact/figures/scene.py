@@ -138,9 +138,11 @@ def _history_figure(scene, fig_name, tables, results, path):
     t_mark = None
     if scene.kind == "tire":
         t_mark = sorted(set((results["footprint_length"] / results["speed"]).round(12)))
+    any_trapped = False
     for ax, name in zip(axs, names):
         rows, total = _thin([r for _, r in ok[ok["surface"] == name].iterrows()])
         curves = [_curve(scene, tables[name], r) for r in rows]
+        any_trapped = any_trapped or any(c["trapped"] for c in curves)
         draw_tire_curves(ax, curves, quantity, t_mark,
                          "time in footprint:" if t_mark else None, labels=len(curves) <= 8)
         title = _surface_label(scene, name)
@@ -154,7 +156,8 @@ def _history_figure(scene, fig_name, tables, results, path):
     ax0 = axs[0]
     ax0.plot([], [], color="0.4", lw=0.8, ls="--",
              label=r"$\bar u/\bar u_\infty$ = 1.1, 1.01, 1.001 (- -, -., :)")
-    ax0.plot([], [], color="0.4", lw=1.0, ls="-.", label=r"trapped: $\bar u_{\rm trap}$")
+    if any_trapped:
+        ax0.plot([], [], color="0.4", lw=1.0, ls="-.", label=r"trapped: $\bar u_{\rm trap}$")
     if quantity == "u":
         ax0.plot([], [], color="0.4", lw=0.6, label="flat surfaces")
     _finish(fig, axs, scene.title, legend_loc="upper right")
