@@ -242,8 +242,10 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
     if not isinstance(tables, Tables):
         raise ValueError(f"tables = {tables!r} is invalid: must be a fastcontact Tables")
     tables._need(theory)
-    if profile not in ("uniform", "hertz"):
-        raise ValueError(f"profile = {profile!r} is invalid: must be 'uniform' or 'hertz'")
+    if not (isinstance(profile, str) and profile in ("uniform", "hertz")):
+        shown = profile if isinstance(profile, str) else "array(...)"
+        raise ValueError(f"profile = {shown!r} is invalid with alpha_pv: must be 'uniform' or "
+                         f"'hertz' (sampled profiles are not implemented for the Barus fluid)")
     dp = check_positive("dp", dp, "[Pa]", allow_zero=True)
     L_y = check_positive("L_y", L_y, "[m]")
     E_star = check_positive("E_star", E_star, "[Pa]")
