@@ -138,7 +138,10 @@ class Calibration:
     @classmethod
     def from_toml(cls, source):
         """From TOML text or a path to a TOML file written by :meth:`to_toml`."""
-        import tomllib
+        try:
+            import tomllib
+        except ModuleNotFoundError:  # Python 3.10
+            import tomli as tomllib
 
         d = tomllib.loads(_read_text(source))
         d["provenance"] = json.loads(d.pop("provenance_json", "{}"))
