@@ -1,9 +1,10 @@
-"""The shipped example scenes (``fastcontact/scenes/*.toml``, canned studies) and the lookup
-of embedded default tables by name."""
+"""The shipped example scenes (``fastcontact/scenes/*.toml``, canned studies); the lookup of
+embedded default tables by name is :func:`fastcontact.tables.defaults.default_table_path`."""
 from __future__ import annotations
 
 from pathlib import Path
 
+from ..tables.defaults import default_table_path
 from .schema import did_you_mean
 
 __all__ = ["list_example_scenes", "example_scene_path", "default_table_path", "SCENES_DIR"]
@@ -30,29 +31,3 @@ def example_scene_path(name) -> Path:
         raise FileNotFoundError(f"scene {name!r} is neither a file nor a shipped example scene"
                                 + did_you_mean(name, list_example_scenes()))
     return p
-
-
-def default_table_path(name) -> Path:
-    """Path of an embedded default table (``asphalt_072mm``, ``pmma_34um`` ...).
-
-    Looks in the package data ``fastcontact/data/`` first, then the source checkout's
-    ``tables/`` folder. ``name`` may omit the ``.parquet`` suffix.
-
-    Raises
-    ------
-    FileNotFoundError
-        Listing the available names.
-    """
-    name = str(name)
-    if not name.endswith(".parquet"):
-        name += ".parquet"
-    if "/" in name or "\\" in name or name.startswith("."):
-        raise FileNotFoundError(f"table {name!r} is not a default table name")
-    dirs = [_PACKAGE / "data", _PACKAGE.parent / "tables"]
-    for d in dirs:
-        p = d / name
-        if p.is_file():
-            return p
-    avail = sorted({p.name for d in dirs if d.is_dir() for p in d.glob("*.parquet")})
-    raise FileNotFoundError(f"table {name!r} is neither a file nor an embedded default table "
-                            f"(available: {', '.join(avail) or 'none'})")

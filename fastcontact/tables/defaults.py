@@ -28,7 +28,7 @@ from ..surface.psd import SelfAffinePSD
 from .build import precompute
 from .store import Tables
 
-__all__ = ["DEFAULT_SURFACES", "default_surface", "default_table_path", "load_default_tables",
+__all__ = ["DEFAULT_SURFACES", "UnknownDefaultTable", "default_surface", "default_table_path", "load_default_tables",
            "build_default_tables"]
 
 DEFAULT_SURFACES = {
@@ -60,9 +60,41 @@ def default_surface(name):
     return SelfAffinePSD(**DEFAULT_SURFACES[_check_name(name)])
 
 
+class UnknownDefaultTable(FileNotFoundError, ValueError):
+    """A name that is not one of the embedded default tables (both a missing file and a bad value)."""
+
+
 def default_table_path(name) -> Path:
-    """Path of the shipped Parquet tables of ``name`` (inside the package; the only definition)."""
-    return PACKAGE_DATA / f"{_check_name(name)}.parquet"
+    """Path of the shipped Parquet tables of an embedded default surface (the only definition).
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`DEFAULT_SURFACES` (``"asphalt_072mm"``, ...); a ``.parquet`` suffix is
+        allowed.
+
+    Returns
+    -------
+    pathlib.Path
+        The copy inside the package (``fastcontact/data``), else the source checkout's
+        ``tables/``.
+
+    Raises
+    ------
+    UnknownDefaultTable
+        (a FileNotFoundError and a ValueError) naming the available tables.
+    """
+    stem = str(name)
+    stem = stem[: -len(".parquet")] if stem.endswith(".parquet") else stem
+    if stem not in DEFAULT_SURFACES:
+        raise UnknownDefaultTable(f"table {str(name)!r} is not an embedded default table "
+                                  f"(available: {', '.join(sorted(DEFAULT_SURFACES))})")
+    for folder in (PACKAGE_DATA, Path(__file__).resolve().parent.parent.parent / "tables"):
+        path = folder / f"{stem}.parquet"
+        if path.is_file():
+            return path
+    raise FileNotFoundError(f"the embedded table {stem}.parquet is missing from {PACKAGE_DATA}: "
+                            f"reinstall fastcontact or run `fastcontact tables defaults`")
 
 
 def load_default_tables(name):
