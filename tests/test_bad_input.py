@@ -185,13 +185,15 @@ def test_bad_types_refused_in_psd(bad):
 
 
 def test_bool_message_says_why():
-    with pytest.raises(ValueError, match=r"^E_star = True is invalid: it is a boolean"):
+    with pytest.raises(ValueError, match=r"^E_star = True is invalid: must be a real number .*"
+                                         r"\[Pa\]; it is a boolean"):
         contact.mean_separation(_psd(), 1e5, True)
 
 
 def test_masked_arrays_honoured():
     p = np.ma.masked_array([1e4, 2e4, 3e4], mask=[False, True, False])
-    with pytest.raises(ValueError, match=r"^p = .*1 masked value\(s\) \(first at index \(1,\)\)"):
+    with pytest.raises(ValueError, match=r"^p = .* is invalid: must have no masked values; 1 masked value\(s\), first at "
+                                         r"index \(1,\)"):
         contact.mean_separation(_psd(), p, E_STAR)
     clean = np.ma.masked_array([1e4, 3e4], mask=[False, False])
     np.testing.assert_array_equal(contact.mean_separation(_psd(), clean, E_STAR),

@@ -87,7 +87,7 @@ def _fail(name: str, value, requirement: str, unit: str = "", bad=None) -> None:
 def _refuse(name: str, value, why: str, unit: str = "") -> None:
     u = unit_label(unit)
     want = f"a real number or array of real numbers{(' in ' + u) if u else ''}"
-    raise ValueError(f"{name} = {_short(repr(value))} is invalid: {why}; must be {want}")
+    raise ValueError(f"{name} = {_short(repr(value))} is invalid: must be {want}; {why}")
 
 
 # ============================================================================ units
@@ -127,8 +127,9 @@ def _strip_units(name: str, value, unit: str):
     try:
         conv = value.to(target[0] if pint_like else target[1])
     except Exception as exc:  # noqa: BLE001 - DimensionalityError, UnitConversionError, ...
-        raise ValueError(f"{name} = {_short(str(value))} is invalid: it carries units "
-                         f"({_short(str(units))}) that cannot be converted: {hint} "
+        raise ValueError(f"{name} = {_short(str(value))} is invalid: must be a number in "
+                         f"{unit_label(unit) or 'SI'} or a quantity convertible to it; its units "
+                         f"({_short(str(units))}) cannot be converted: {hint} "
                          f"({type(exc).__name__})") from None
     for attr in ("magnitude", "value", "v"):
         mag = getattr(conv, attr, None)
@@ -190,9 +191,10 @@ def _plain(name: str, value, unit: str):
         n_masked = int(np.ma.count_masked(value))
         if n_masked:
             first = np.argwhere(np.ma.getmaskarray(value))[0]
-            raise ValueError(f"{name} = {_fmt(np.ma.getdata(value))} is invalid: {n_masked} "
-                             f"masked value(s) (first at index {tuple(int(i) for i in first)}); "
-                             f"fill or remove them — masks are never dropped silently")
+            raise ValueError(f"{name} = {_fmt(np.ma.getdata(value))} is invalid: must have no "
+                             f"masked values; {n_masked} masked value(s), first at index "
+                             f"{tuple(int(i) for i in first)}: fill or remove them (masks are "
+                             f"never dropped silently)")
         value = np.ma.getdata(value)
     if isinstance(value, (list, tuple)):
         try:
