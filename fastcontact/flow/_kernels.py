@@ -44,6 +44,10 @@ class EMTSpec(NamedTuple):
         Initial Gauss–Kronrod panels.
     tol : float
         Target relative accuracy of σ̄ [-].
+    threshold : float
+        Contact-area fraction A_c at which the generalized Bruggeman medium stops the flow
+        [-] (Kirkpatrick, Rev. Mod. Phys. 45, 574 (1973), doi:10.1103/RevModPhys.45.574,
+        eq. 5.8, with k = A_c/(1 - A_c)); 0.5 (k = 1) is the 2-D Bruggeman medium.
     """
 
     h_rms: float
@@ -56,6 +60,7 @@ class EMTSpec(NamedTuple):
     ghw: np.ndarray
     n_start: int
     tol: float
+    threshold: float = 0.5
 
 
 @njit(cache=True)
@@ -90,11 +95,20 @@ EMT_GRADE = 3.0
 
 
 @njit(cache=True)
-def _node_terms(s, sj, hzj, almqvist, ghx, ghw):
-    """(Σ 2r, Σ 2r(1-r)) of one node, r = s/(s + σ(u)); Gauss–Hermite average if almqvist."""
+def _node_terms(s, sj, hzj, almqvist, ghx, ghw, kk=1.0):
+    """(Σ 2r, Σ 2r(1-r)) of one node, r = s/(s + σ(u)); Gauss–Hermite average if almqvist.
+
+    Generalized medium (kk = A_c/(1 - A_c) != 1): (Σ (1+kk) r, Σ (1+kk) r (1 - kk r)) with
+    r = s/(kk s + σ(u)); kk == 1 takes the 2-D Bruggeman expressions unchanged.
+    """
     if sj == math.inf:
         return 0.0, 0.0  # masked: u1 undefined where dA/dζ = 0; zero weight
     if not almqvist:
+        if kk != 1.0:
+            if sj == 0.0:
+                return (1.0 + kk) / kk, 0.0
+            r = s / (kk * s + sj)
+            return (1.0 + kk) * r, (1.0 + kk) * r * (1.0 - kk * r)
         if sj == 0.0:
             return 2.0, 0.0
         r = s / (s + sj)
@@ -105,6 +119,11 @@ def _node_terms(s, sj, hzj, almqvist, ghx, ghw):
     for k in range(ghx.size):
         u = abs(mu + math.sqrt(2.0) * hzj * ghx[k])
         su = u * u * u
+        if kk != 1.0:
+            r = s / (kk * s + su) if kk * s + su > 0.0 else 1.0 / kk
+            acc += ghw[k] * (1.0 + kk) * r
+            dacc += ghw[k] * (1.0 + kk) * r * (1.0 - kk * r)
+            continue
         r = s / (s + su) if s + su > 0.0 else 1.0
         acc += ghw[k] * 2.0 * r
         dacc += ghw[k] * 2.0 * r * (1.0 - r)
@@ -112,16 +131,19 @@ def _node_terms(s, sj, hzj, almqvist, ghx, ghw):
 
 
 @njit(cache=True)
-def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw, guess=0.0):
+def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw, guess=0.0, threshold=0.5):
     """Solve Σ_j W_j 2s/(s + σ_j) + 2 A1 - 1 = 0 for s > 0 (2-D Bruggeman, reduced units).
 
     With ``almqvist`` each node is a reflected Gaussian of width hz[j] around u1 = σ_j^(1/3)
     (Gauss–Hermite nodes ghx, ghw). Safeguarded Newton in ln s, started from ``guess`` when
     it is inside the bracket (warm start), else from the bracket's middle. Returns 0 when
-    A1 >= 0.5 (percolated).
+    A1 >= threshold (percolated). A threshold A_c != 0.5 solves the generalized medium
+    Σ_j W_j (1+k)s/(σ_j + k s) + A1/k - (1 - A1) = 0, k = A_c/(1 - A_c) (Kirkpatrick 1973,
+    eq. 5.8); A_c = 0.5 (k = 1) is the equation above, evaluated by the same expressions.
     """
-    if A1 >= 0.5:
+    if A1 >= threshold:
         return 0.0
+    kk = threshold / (1.0 - threshold)
     inv = 0.0
     smax = 0.0
     for j in range(W.size):
@@ -136,7 +158,13 @@ def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw, guess=0.0):
                 smax = sj
     if smax <= 0.0:
         return 0.0
-    lo = math.log(max((1.0 - 2.0 * A1) / (2.0 * inv) if inv > 0 else smax * 1e-300, 1e-300)) - 1.0
+    if kk == 1.0:
+        s_lo = (1.0 - 2.0 * A1) / (2.0 * inv) if inv > 0 else smax * 1e-300
+        f0 = 2.0 * A1 - 1.0
+    else:
+        s_lo = ((1.0 - A1) - A1 / kk) / ((1.0 + kk) * inv) if inv > 0 else smax * 1e-300
+        f0 = A1 / kk - (1.0 - A1)
+    lo = math.log(max(s_lo, 1e-300)) - 1.0
     if almqvist:
         lo -= 30.0
     hi = math.log(smax) + 1.0
@@ -145,10 +173,10 @@ def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw, guess=0.0):
         y = math.log(guess)
     for it in range(200):
         s = max(math.exp(y), 1e-300)
-        f = 2.0 * A1 - 1.0
+        f = f0
         df = 0.0
         for j in range(W.size):
-            t1, t2 = _node_terms(s, sig[j], hz[j], almqvist, ghx, ghw)
+            t1, t2 = _node_terms(s, sig[j], hz[j], almqvist, ghx, ghw, kk)
             f += W[j] * t1
             df += W[j] * t2
         if f > 0.0:
@@ -205,8 +233,9 @@ def emt_sigma(sk, pbar, ktab, spec):
     """
     almqvist, ghx, ghw, tol = spec.almqvist, spec.ghx, spec.ghw, spec.tol
     A1 = _area1(sk.cum3, pbar)
-    if A1 >= 0.5:
+    if A1 >= spec.threshold:
         return 0.0, 0.0, 0
+    kk = spec.threshold / (1.0 - spec.threshold)
     cap = EMT_MAX_PANELS * 15
     sig = np.empty(cap)
     hz = np.zeros(cap)
@@ -224,7 +253,7 @@ def emt_sigma(sk, pbar, ktab, spec):
     est = 0.0
     while True:
         n = 15 * npan
-        s = bruggeman(WK[:n], sig[:n], A1, almqvist, hz[:n], ghx, ghw, s)
+        s = bruggeman(WK[:n], sig[:n], A1, almqvist, hz[:n], ghx, ghw, s, spec.threshold)
         if s <= 0.0:
             return 0.0, 0.0, n
         # per-panel error of the Bruggeman residual, relative to d f / d ln s
@@ -236,7 +265,7 @@ def emt_sigma(sk, pbar, ktab, spec):
             ek = 0.0
             eg = 0.0
             for j in range(15 * k, 15 * k + 15):
-                t1_, t2_ = _node_terms(s, sig[j], hz[j], almqvist, ghx, ghw)
+                t1_, t2_ = _node_terms(s, sig[j], hz[j], almqvist, ghx, ghw, kk)
                 ek += WK[j] * t1_
                 eg += WG[j] * t1_
                 dfl += WK[j] * t2_
@@ -262,9 +291,11 @@ def emt_sigma(sk, pbar, ktab, spec):
 
 @njit(cache=True, parallel=True)
 def emt_kernel(sk, pbar, ktab, spec, sigma, percolated, err, nevals):
-    """Bruggeman σ̄ = 12ησ_eff/h_rms³ per reduced pressure (u1-based P(u)) into the out arrays."""
+    """Bruggeman σ̄ = 12ησ_eff/h_rms³ per reduced pressure (u1-based P(u)) into the out arrays.
+
+    Percolated where A(ζ1)/A0 >= spec.threshold (0.5: the 2-D Bruggeman medium)."""
     for i in prange(pbar.size):
-        percolated[i] = _area1(sk.cum3, pbar[i]) >= 0.5
+        percolated[i] = _area1(sk.cum3, pbar[i]) >= spec.threshold
         s, es, ne = emt_sigma(sk, pbar[i], ktab, spec)
         sigma[i] = s
         err[i] = es

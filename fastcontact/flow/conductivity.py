@@ -9,7 +9,9 @@ Theories
 ``"emt"``                2-D Bruggeman effective medium over P(u) from u1(ζ)
 
 Percolation is exact: critical junction gives σ_eff = 0 when A(ζ1)/A0 >= a_perc; the
-effective medium when A(ζ1)/A0 >= 0.5. Every result carries a ``percolated`` flag.
+effective medium when A(ζ1)/A0 >= emt_threshold (0.5: 2-D Bruggeman; other values: the
+generalized medium of Kirkpatrick, Rev. Mod. Phys. 45, 574 (1973), doi:10.1103/RevModPhys.45.574).
+Every result carries a ``percolated`` flag.
 References: B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010),
 doi:10.1140/epje/i2010-10626-9 and Eur. Phys. J. E 31, 159 (2010), doi:10.1140/epje/i2010-10558-6.
 """
@@ -29,7 +31,7 @@ from ..kernels.quadrature import gauss_hermite, gauss_legendre
 from ..kernels.special import k_table
 from ._kernels import EMT_TOL, EMTSpec, critical_junction_kernel, emt_kernel
 
-__all__ = ["THEORIES", "EMT_TOL", "check_theory", "conductivity", "flow_factor", "sigma_bar",
+__all__ = ["THEORIES", "EMT_TOL", "check_theory", "check_emt_threshold", "conductivity", "flow_factor", "sigma_bar",
            "SigmaBar", "SigmaDetails", "Conductivity", "FlowFactor"]
 
 #: initial Gauss–Kronrod panels of the adaptive effective-medium integral over A
@@ -103,8 +105,14 @@ def check_theory(theory):
     return theory
 
 
+def check_emt_threshold(emt_threshold):
+    """``emt_threshold`` as a float in (0, 1) [-], else ValueError naming it."""
+    return float(check_range("emt_threshold", emt_threshold, 0.0, 1.0, "[-]",
+                             lo_open=True, hi_open=True))
+
+
 def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start=EMT_N_START,
-              tol=EMT_TOL, almqvist=False, glx=None, glw=None, panel=PANEL):
+              tol=EMT_TOL, almqvist=False, glx=None, glw=None, panel=PANEL, emt_threshold=0.5):
     """Reduced conductivity σ̄ = 12ησ_eff/h_rms³ [-] at reduced contact pressures p̄ = p/E*.
 
     Parameters
@@ -115,7 +123,7 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
         Reduced contact pressures p/E* [-], > 0 (flattened).
     theory : {"average", "critical_junction", "emt"}
         Flow theory.
-    gamma, a_perc, alpha_cj, tol, almqvist
+    gamma, a_perc, alpha_cj, tol, almqvist, emt_threshold
         As in :func:`conductivity`.
     n_start : int
         Initial Gauss–Kronrod panels of the effective-medium integral.
@@ -128,6 +136,7 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
         ``(sigma_bar, percolated, details)``; ``details`` is a :class:`SigmaDetails`.
     """
     check_theory(theory)
+    emt_threshold = check_emt_threshold(emt_threshold)
     pbar = np.ascontiguousarray(np.asarray(pbar, dtype=np.float64).ravel())
     h = psd.h_rms
     if glx is None:
@@ -149,14 +158,14 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
     err = np.empty(pbar.size)
     nev = np.empty(pbar.size, dtype=np.int64)
     spec = EMTSpec(float(h), float(gamma), glx, glw, float(panel), bool(almqvist), ghx, ghw,
-                   int(n_start), float(tol))
+                   int(n_start), float(tol), emt_threshold)
     with _dynamic_schedule():
         emt_kernel(sk, pbar, k_table(), spec, sig, perc, err, nev)
     return SigmaBar(sig, perc, SigmaDetails(error_estimate=err, u1_evaluations=nev))
 
 
 def conductivity(psd, p, E_star, eta, theory="average", *, gamma=1.0, a_perc=0.5,
-                 alpha_cj=1.0, tol=EMT_TOL, almqvist=False):
+                 alpha_cj=1.0, tol=EMT_TOL, almqvist=False, emt_threshold=0.5):
     """Effective interfacial fluid conductivity σ_eff(p_cont) [m³/(Pa·s)] by direct quadrature.
 
     Parameters
@@ -181,6 +190,11 @@ def conductivity(psd, p, E_star, eta, theory="average", *, gamma=1.0, a_perc=0.5
         Target relative accuracy of the adaptive effective-medium integral [-].
     almqvist : bool
         Gaussian-broadened P(u) (Almqvist et al. 2011, doi:10.1016/j.jmps.2011.08.004).
+    emt_threshold : float
+        Effective-medium percolation threshold A_c in (0, 1) [-]: the flow stops at
+        A(ζ1)/A0 = A_c. 0.5 is the 2-D Bruggeman medium (bit-identical to earlier releases);
+        other values solve Σ W (1+k)σ̄/(σ + kσ̄) + A1/k - (1 - A1) = 0, k = A_c/(1 - A_c)
+        (Kirkpatrick 1973, eq. 5.8).
 
     Returns
     -------
@@ -198,7 +212,8 @@ def conductivity(psd, p, E_star, eta, theory="average", *, gamma=1.0, a_perc=0.5
     alpha_cj = float(check_positive("alpha_cj", alpha_cj, "[-]"))
     tol = float(check_range("tol", tol, 1e-14, 1e-2, "[-]"))
     sb, perc, _ = sigma_bar(psd, np.ravel(p) / E_star, theory, gamma=gamma, a_perc=a_perc,
-                            alpha_cj=alpha_cj, tol=tol, almqvist=bool(almqvist))
+                            alpha_cj=alpha_cj, tol=tol, almqvist=bool(almqvist),
+                            emt_threshold=emt_threshold)
     sig = sb.reshape(np.shape(p)) * psd.h_rms ** 3 / (12.0 * eta)
     return Conductivity(sig, perc.reshape(np.shape(p)))
 

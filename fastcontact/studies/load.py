@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import fnmatch
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +19,7 @@ except ModuleNotFoundError:   # Python 3.10
     import tomli as tomllib
 
 from .._core.vocab import THEORIES
+from ..validation.calibration import Calibration
 from .examples import example_scene_path
 from .kinds import KINDS
 from .scene import Scene, SceneError, count_cases
@@ -264,9 +266,45 @@ def _check_material(given, problems):
         problems.append("material.E2/nu2: give both the second solid's E2 and nu2, or neither")
 
 
+def _calibration_options(kind, fixed, given_opts, base, problems):
+    """``tables.calibration``: the calibration file's constants merged into ``given_opts``.
+
+    The file (relative to the scene) is read by
+    :meth:`fastcontact.validation.Calibration.from_toml` (plain TOML, no BEM extra needed);
+    a constant also given in ``[tables]`` must agree.
+    ``emt_threshold`` is added only when it differs from 0.5 (default tables, cache keys).
+    """
+    v = fixed.pop("calibration", None)
+    if v is None:
+        return
+    p = Path(v).expanduser()
+    p = p if p.is_absolute() else base / p
+    if not p.is_file():
+        problems.append(f"tables.calibration = {v!r}: file not found ({p})")
+        return
+    try:
+        cal = Calibration.from_toml(p)
+    except Exception as exc:  # noqa: BLE001 - TOML, key and range errors alike
+        problems.append(f"tables.calibration = {v!r}: not a calibration file "
+                        f"({type(exc).__name__}: {exc})")
+        return
+    for k in ("gamma", "a_perc", "alpha_cj", "emt_threshold"):
+        val = float(getattr(cal, k))
+        if k in given_opts and not math.isclose(float(given_opts[k]), val, rel_tol=1e-12):
+            problems.append(f"tables.{k} = {given_opts[k]!r}: conflicts with tables.calibration "
+                            f"= {v!r}, which sets {k} = {val!r} (give one or the other)")
+        elif k == "alpha_cj" and kind == "seal":
+            if val != 1.0:
+                problems.append(f"tables.calibration = {v!r} sets alpha_cj = {val!r}: for a seal "
+                                f"study give it as study.alpha_cj = {val!r} (tables keep α_cj = 1)")
+        elif k != "emt_threshold" or val != 0.5:
+            given_opts[k] = val
+
+
 def _table_options(kind, fixed, given, base, problems):
     """(options with defaults, options given, cache folder) of ``[tables]``."""
     given_opts = {k: fixed.pop(k) for k in ("gamma", "a_perc", "alpha_cj") if k in fixed}
+    _calibration_options(kind, fixed, given_opts, base, problems)
     if kind == "seal" and ("tables", "alpha_cj") in given:
         problems.append("tables.alpha_cj: for a seal study give the junction factor as "
                         "study.alpha_cj (it rescales σ_cj by α_cj³ on tables built with α_cj = 1)")
@@ -344,9 +382,10 @@ def load_scene(scene, *, for_sweep=False, base_dir=None, max_cases=None) -> Scen
     ``convention``; or ``h_rms``, ``hurst``, ``q0``, ``q1`` [, ``q_roll``]), ``[material]``
     (``E_star``, or ``E``, ``nu`` [, ``E2``, ``nu2``]), ``[fluid]`` (``eta``, ``rho``),
     ``[geometry]`` (``R``, ``L``, ``L_y``), ``[tables]`` (``gamma``, ``a_perc``, ``alpha_cj``,
-    ``cache_dir``), ``[outputs]`` (``columns``, ``figures``, ``max_cases``), ``[sweep]``
-    (``combine`` = product | zip). Numbers are SI or strings with units (``"0.2 MPa"``). Every
-    axis key may be a scalar, a list or a range ``{start, stop, num, log}``.
+    ``cache_dir``, ``calibration`` = a calibration TOML file), ``[outputs]`` (``columns``,
+    ``figures``, ``max_cases``), ``[sweep]`` (``combine`` = product | zip). Numbers are SI or
+    strings with units (``"0.2 MPa"``). Every axis key may be a scalar, a list or a range
+    ``{start, stop, num, log}``.
     """
     data, text, source, base = _read_source(scene, base_dir)
     problems = []

@@ -100,6 +100,8 @@ SCHEMA = {
         "a_perc": _K("num", lo=0, hi=1, lo_open=True, hi_open=True),
         "alpha_cj": _K("num", lo=0, lo_open=True),
         "cache_dir": _K("str"),
+        "calibration": _K("str", doc="calibration TOML file (fastcontact bem calibrate), "
+                          "relative to the scene: sets gamma, a_perc, alpha_cj, emt_threshold"),
     },
     "outputs": {
         "columns": _K("strlist"),

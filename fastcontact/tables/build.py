@@ -6,6 +6,7 @@
 """
 from __future__ import annotations
 
+import json
 import math
 import time
 
@@ -15,7 +16,7 @@ from scipy.special import erf
 from .._core.validate import check_positive, check_range
 from .._core.vocab import THEORIES
 from ..contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
-from ..flow.conductivity import EMT_TOL, check_theory, sigma_bar
+from ..flow.conductivity import EMT_TOL, check_emt_threshold, check_theory, sigma_bar
 from ..kernels.hermite import quintic_np
 from ..kernels.locate import Grid
 from ..surface.psd import PSD
@@ -60,8 +61,44 @@ def default_grid(surface: PSD, gamma=1.0, points_per_decade=DEFAULT_POINTS_PER_D
     return Grid(lo, hi, int(round((hi - lo) * ppd)) + 1)
 
 
-def _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist):
-    """(theories in request order without repeats, validated options dict)."""
+#: the constants a calibration sets, with precompute's defaults
+CALIBRATED = {"gamma": 1.0, "alpha_cj": 1.0, "a_perc": 0.5, "emt_threshold": 0.5}
+
+
+def _plain(obj):
+    """JSON fallback for a calibration's provenance: numpy scalars/arrays, else str."""
+    if hasattr(obj, "tolist"):
+        return obj.tolist()
+    return str(obj)
+
+
+def _calibration_block(calibration, given):
+    """(constants dict, provenance block) of a calibration; ValueError on a conflict.
+
+    ``calibration`` is duck-typed (attributes gamma, alpha_cj, a_perc, emt_threshold, and
+    optionally fitted, provenance) so that tables need not import fastcontact.validation.
+    ``given`` holds the options passed to precompute; a value that differs from its default
+    and from the calibration's is a conflict.
+    """
+    missing = [k for k in CALIBRATED if not hasattr(calibration, k)]
+    if missing:
+        raise ValueError(f"calibration = {calibration!r} is invalid: it lacks {missing}; pass a "
+                         f"fastcontact.validation.Calibration (attributes {list(CALIBRATED)})")
+    const = {k: float(getattr(calibration, k)) for k in CALIBRATED}
+    for k, v in given.items():
+        if float(v) != CALIBRATED[k] and float(v) != const[k]:
+            raise ValueError(f"{k} = {v!r} is invalid together with calibration: the calibration "
+                             f"sets {k} = {const[k]!r} (pass one or the other)")
+    block = dict(const, fitted=list(getattr(calibration, "fitted", ()) or ()),
+                 provenance=getattr(calibration, "provenance", {}) or {})
+    return const, json.loads(json.dumps(block, default=_plain, sort_keys=True))
+
+
+def _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist, emt_threshold=0.5):
+    """(theories in request order without repeats, validated options dict).
+
+    ``emt_threshold`` is recorded only when it differs from 0.5 (so default tables, and
+    their digests, are those of earlier releases)."""
     if isinstance(theories, str):
         theories = (theories,)
     theories = tuple(dict.fromkeys(check_theory(t) for t in theories))
@@ -74,7 +111,8 @@ def _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist):
         "alpha_cj": float(check_positive("alpha_cj", alpha_cj, "[-]")),
         "emt_tol": float(check_range("emt_tol", emt_tol, 1e-13, 1e-2, "[-]")),
         "emt_almqvist": bool(emt_almqvist),
-    }
+    } | ({} if float(check_emt_threshold(emt_threshold)) == 0.5
+         else {"emt_threshold": check_emt_threshold(emt_threshold)})
 
 
 def _check_grid(grid):
@@ -272,7 +310,8 @@ def _assemble(psd, lnp, cols, theories, options):
         if th == "critical_junction":
             data["zeta_c"] = cols["zeta_c"]
             data["u1c_over_h"] = cols["u1c_over_h"]
-        a_perc = options["a_perc"] if th == "critical_junction" else 0.5
+        a_perc = options["a_perc"] if th == "critical_junction" else \
+            options.get("emt_threshold", 0.5)
         perc_p[th] = math.inf if th == "average" else float(percolation_pressure(psd, 1.0, a_perc))
     zg = Grid(0.0, math.log10(psd.zeta1), pbar.size)
     zeta = zg.nodes()
@@ -284,7 +323,7 @@ def _assemble(psd, lnp, cols, theories, options):
 
 def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid=None, *,
                emt_tol=EMT_TOL, emt_almqvist=False, points_per_decade=None, tolerance=None,
-               refine=True):
+               refine=True, emt_threshold=0.5, calibration=None):
     """Tabulate ū (A4), A (A1), u1(ζc) (A3), σ̄ (eq. 23) and φ_p of a surface on a grid of p̄ = p/E*.
 
     The base grid (uniform in ln p̄) is refined adaptively: every interval whose Hermite
@@ -317,12 +356,21 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
         Overrides of :data:`TOLERANCE` ("u", "p_of_u", "slope", "sigma").
     refine : bool
         False: keep the base grid (errors are still measured and recorded).
+    emt_threshold : float
+        Effective-medium percolation threshold A_c in (0, 1) [-] (0.5: 2-D Bruggeman; see
+        :func:`fastcontact.flow.conductivity.conductivity`). Recorded in ``options`` when != 0.5.
+    calibration : Calibration, optional
+        A :class:`fastcontact.validation.Calibration` (or any object with attributes gamma,
+        alpha_cj, a_perc, emt_threshold): sets those four options. An option passed here with
+        a non-default value that differs from the calibration's raises ValueError. The
+        constants, ``fitted`` and the calibration's ``provenance`` are recorded in
+        ``info["calibration"]`` (covered by the file's metadata_sha256).
 
     Returns
     -------
     Tables
         The tables; ``info`` records the asymptote (eq. 3), percolation pressures, the
-        midpoint errors, node count and build time [s].
+        midpoint errors, node count and build time [s] (and the calibration, if any).
 
     References
     ----------
@@ -330,7 +378,13 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
     """
     t_start = time.perf_counter()
     _check_psd(psd)
-    theories, options = _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist)
+    cal_block = None
+    if calibration is not None:
+        const, cal_block = _calibration_block(calibration, {
+            "gamma": gamma, "alpha_cj": alpha_cj, "a_perc": a_perc, "emt_threshold": emt_threshold})
+        gamma, alpha_cj, a_perc, emt_threshold = (const[k] for k in CALIBRATED)
+    theories, options = _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist,
+                                        emt_threshold)
     gamma = options["gamma"]
     if grid is None:
         ppd = DEFAULT_POINTS_PER_DECADE if points_per_decade is None else points_per_decade
@@ -340,7 +394,8 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
         grid = _check_grid(grid)
     tol = _check_tolerance(tolerance)
     sig_opts = dict(gamma=gamma, a_perc=options["a_perc"], alpha_cj=options["alpha_cj"],
-                    tol=options["emt_tol"], almqvist=options["emt_almqvist"])
+                    tol=options["emt_tol"], almqvist=options["emt_almqvist"],
+                    emt_threshold=options.get("emt_threshold", 0.5))
     lnp, cols, errs, stats = _refine(psd, grid, theories, sig_opts, tol, refine)
     data, perc_p, zg = _assemble(psd, lnp, cols, theories, options)
     u0, beta = asymptote(psd, gamma)
@@ -349,4 +404,6 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
             "interpolation_error": {c: float(e.max()) for c, e in errs.items()},
             "tolerance": tol, "sigma_floor": SIGMA_FLOOR, "nodes": int(lnp.size), **stats,
             "build_seconds": time.perf_counter() - t_start}
+    if cal_block is not None:
+        info["calibration"] = cal_block
     return Tables(psd, theories, options, grid, zg, data, info)

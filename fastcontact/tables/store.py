@@ -134,6 +134,10 @@ class Tables:
     def percolation_pressure(self, theory, E_star=1.0):
         """Contact pressure [Pa] at which ``theory``'s σ_eff vanishes (inf: never).
 
+        That is where A(ζ1)/A0 reaches the tables' threshold: ``options["a_perc"]`` for the
+        critical junction, ``options.get("emt_threshold", 0.5)`` for the effective medium
+        (both set by a calibration, see :func:`~fastcontact.tables.precompute`).
+
         Parameters
         ----------
         theory : {"average", "critical_junction", "emt"}
