@@ -1,11 +1,11 @@
 """Validation shared by the contact-mechanics wrappers (messages name parameter, value, range)."""
 from __future__ import annotations
 
-from .._core.validate import check_range
+from .._core.validate import check_positive, check_range
 from ..surface.psd import PSD
 from ._kernels import psd_kernel
 
-__all__ = ["_check_psd", "_check_gamma", "_check_zeta", "_arrays"]
+__all__ = ["_check_psd", "_check_load", "_check_gamma", "_check_zeta", "_arrays"]
 
 
 def _check_psd(psd):
@@ -14,6 +14,31 @@ def _check_psd(psd):
         raise ValueError(f"psd = {psd!r} is invalid: must be a fastcontact PSD object "
                          f"(SelfAffinePSD, TabulatedPSD, read_psd(...), psd_from_heights(...))")
     return psd
+
+
+def _check_load(psd, p, E_star, p_name="p", p_unit="[Pa]"):
+    """Validate a (psd, p, E_star) triple, in that order (the first bad one raises).
+
+    Parameters
+    ----------
+    psd : PSD
+        Roughness spectrum (a fastcontact PSD object).
+    p : array_like
+        Nominal contact pressure [Pa], > 0 (or the quantity named ``p_name``).
+    E_star : float or array_like
+        Effective modulus [Pa], > 0.
+    p_name : str
+        Name of ``p`` in the error message (default "p"; "u" for a separation).
+    p_unit : str
+        Unit of ``p`` in the error message (default "[Pa]").
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        ``p`` and ``E_star`` as float arrays (see :func:`fastcontact._core.validate.check_positive`).
+    """
+    _check_psd(psd)
+    return check_positive(p_name, p, p_unit), check_positive("E_star", E_star, "[Pa]")
 
 
 def _check_gamma(gamma):

@@ -13,10 +13,15 @@ from scipy.special import erf, erfinv as sp_erfinv
 
 from .._core.validate import check_positive, check_range
 from ..kernels.special import erfinv
-from ._checks import _check_psd, _check_zeta
+from ._checks import _check_load, _check_psd, _check_zeta
 from ._kernels import q_for_m3
 
 __all__ = ["stiffness_G", "area_fraction", "percolation_pressure", "critical_magnification"]
+
+
+def _stiffness(psd, E_star, zeta):
+    """G(ζ) [Pa²] (A2) of validated inputs (E_star [Pa] and ζ [-] broadcast)."""
+    return 0.25 * math.pi * E_star ** 2 * np.asarray(psd.moment(3.0, psd.q0, np.asarray(zeta) * psd.q0))
 
 
 def stiffness_G(psd, E_star, zeta):
@@ -38,8 +43,7 @@ def stiffness_G(psd, E_star, zeta):
     """
     _check_psd(psd)
     E_star = check_positive("E_star", E_star, "[Pa]")
-    zeta = _check_zeta(psd, zeta)
-    return 0.25 * math.pi * E_star ** 2 * np.asarray(psd.moment(3.0, psd.q0, zeta * psd.q0))
+    return _stiffness(psd, E_star, _check_zeta(psd, zeta))
 
 
 def area_fraction(psd, p, E_star, zeta=None):
@@ -61,11 +65,9 @@ def area_fraction(psd, p, E_star, zeta=None):
     ndarray
         A(ζ)/A0 [-], in [0, 1].
     """
-    _check_psd(psd)
-    p = check_positive("p", p, "[Pa]")
-    E_star = check_positive("E_star", E_star, "[Pa]")
+    p, E_star = _check_load(psd, p, E_star)
     zeta = psd.zeta1 if zeta is None else _check_zeta(psd, zeta)
-    G = 0.25 * math.pi * E_star ** 2 * np.asarray(psd.moment(3.0, psd.q0, np.asarray(zeta) * psd.q0))
+    G = _stiffness(psd, E_star, zeta)
     with np.errstate(divide="ignore"):
         x = p / (2.0 * np.sqrt(G))
     return erf(x)
@@ -114,9 +116,7 @@ def critical_magnification(psd, p, E_star, a_perc=0.5):
     ndarray
         ζc [-]; ``inf`` where A(ζ1)/A0 >= a_perc (the contact has percolated, no open channel).
     """
-    _check_psd(psd)
-    p = check_positive("p", p, "[Pa]")
-    E_star = check_positive("E_star", E_star, "[Pa]")
+    p, E_star = _check_load(psd, p, E_star)
     a_perc = float(check_range("a_perc", a_perc, 0.0, 1.0, "[-]", lo_open=True, hi_open=True))
     pb, Eb = np.broadcast_arrays(p, E_star)
     pbar = (pb / Eb).ravel()

@@ -15,7 +15,7 @@ from scipy.special import beta as beta_fn, digamma
 from .._core.validate import check_positive, check_range
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.special import EULER_GAMMA, K_ZERO, k_table
-from ._checks import _check_gamma, _check_psd, _check_zeta
+from ._checks import _check_gamma, _check_load, _check_psd, _check_zeta
 from ._kernels import (PANEL, asymptote_kernel, contact_pressure_kernel, mean_separation_kernel,
                        psd_kernel, u1_kernel)
 
@@ -23,17 +23,40 @@ __all__ = ["mean_separation", "separation_slope", "u1", "contact_pressure", "asy
            "asymptote_self_affine"]
 
 
-def _separation(psd, p, E_star, zeta, gamma, glx=None, glw=None, panel=PANEL, second=False):
-    """(ū, dū/d ln p[, d²ū/d(ln p)²]) [m] by direct quadrature (broadcast over p, E*, ζ)."""
-    _check_psd(psd)
-    p = check_positive("p", p, "[Pa]")
-    E_star = check_positive("E_star", E_star, "[Pa]")
+def _reduced_inputs(psd, p, E_star, zeta, gamma):
+    """Validated inputs of the (A4)/(A3) kernels, broadcast over (p, E*, ζ) and flattened.
+
+    Parameters
+    ----------
+    psd : PSD
+        Roughness spectrum.
+    p : array_like
+        Nominal contact pressure [Pa], > 0.
+    E_star : float or array_like
+        Effective modulus [Pa], > 0.
+    zeta : array_like
+        Magnification in [1, ζ1] [-].
+    gamma : float
+        Yang–Persson factor in (0, 1] [-].
+
+    Returns
+    -------
+    (tuple, ndarray, ndarray, float)
+        Broadcast shape, reduced pressures p̄ = p/E* [-] and ζ [-] (flat, contiguous
+        float64), and γ.
+    """
+    p, E_star = _check_load(psd, p, E_star)
     zeta = _check_zeta(psd, zeta)
     gamma = _check_gamma(gamma)
     pb, Eb, zb = np.broadcast_arrays(p, E_star, zeta)
-    shape = pb.shape
     pbar = np.ascontiguousarray((pb / Eb).ravel(), dtype=np.float64)
     z = np.ascontiguousarray(zb.ravel(), dtype=np.float64)
+    return pb.shape, pbar, z, gamma
+
+
+def _separation(psd, p, E_star, zeta, gamma, glx=None, glw=None, panel=PANEL, second=False):
+    """(ū, dū/d ln p[, d²ū/d(ln p)²]) [m] by direct quadrature (broadcast over p, E*, ζ)."""
+    shape, pbar, z, gamma = _reduced_inputs(psd, p, E_star, zeta, gamma)
     if glx is None:
         glx, glw = gauss_legendre()
     out = np.empty(pbar.size)
@@ -105,18 +128,11 @@ def u1(psd, p, E_star, zeta, gamma=1.0):
         high pressure) u1 is undefined; those entries are **masked** (they carry zero weight
         in every flow theory), never returned as inf or NaN.
     """
-    _check_psd(psd)
-    p = check_positive("p", p, "[Pa]")
-    E_star = check_positive("E_star", E_star, "[Pa]")
-    zeta = _check_zeta(psd, zeta)
-    gamma = _check_gamma(gamma)
-    pb, Eb, zb = np.broadcast_arrays(p, E_star, zeta)
-    pbar = np.ascontiguousarray((pb / Eb).ravel(), dtype=np.float64)
-    z = np.ascontiguousarray(zb.ravel(), dtype=np.float64)
+    shape, pbar, z, gamma = _reduced_inputs(psd, p, E_star, zeta, gamma)
     glx, glw = gauss_legendre()
     out = np.empty(pbar.size)
     u1_kernel(psd_kernel(psd), pbar, z, gamma, k_table(), glx, glw, PANEL, out)
-    out = out.reshape(pb.shape)
+    out = out.reshape(shape)
     mask = ~np.isfinite(out)
     return np.ma.MaskedArray(np.where(mask, 0.0, out), mask=mask)
 
@@ -142,9 +158,7 @@ def contact_pressure(psd, u, E_star, gamma=1.0):
     ndarray
         p_cont [Pa], broadcast shape of (u, E_star).
     """
-    _check_psd(psd)
-    u = check_positive("u", u, "[m]")
-    E_star = check_positive("E_star", E_star, "[Pa]")
+    u, E_star = _check_load(psd, u, E_star, "u", "[m]")
     gamma = _check_gamma(gamma)
     ub, Eb = np.broadcast_arrays(u, E_star)
     ubar = np.ascontiguousarray(ub.ravel(), dtype=np.float64)

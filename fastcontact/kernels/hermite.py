@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from numba import njit
 
+from ._index import clamp_index
+
 __all__ = ["cubic_uniform", "quintic_interval", "quintic_unit", "quintic_np"]
 
 
@@ -15,11 +17,7 @@ __all__ = ["cubic_uniform", "quintic_interval", "quintic_unit", "quintic_np"]
 def cubic_uniform(t, t0, dt, val, der):
     """Cubic Hermite on the uniform grid ``t0 + i dt`` with values and d/dt (clamped ends)."""
     x = (t - t0) / dt
-    i = int(x)
-    if i < 0:
-        i = 0
-    if i > val.size - 2:
-        i = val.size - 2
+    i = clamp_index(int(x), val.size - 2)
     u = x - i
     u2 = u * u
     u3 = u2 * u
@@ -28,10 +26,25 @@ def cubic_uniform(t, t0, dt, val, der):
 
 
 @njit(cache=True)
-def quintic_interval(x, x0, x1, y0, y1, d0, d1, s0, s1):
-    """Quintic Hermite at ``x`` on [x0, x1] from values y, first derivatives d, second s."""
-    h = x1 - x0
-    t = (x - x0) / h
+def _quintic_value(t, h, y0, d0, s0, y1, d1, s1):
+    """The quintic Hermite polynomial at t = (x - x0)/h in [0, 1] (one copy for both kernels).
+
+    Parameters
+    ----------
+    t : float
+        Unit variable (x - x0)/h [-].
+    h : float
+        Interval width x1 - x0 [units of x].
+    y0, d0, s0 : float
+        Value, d/dx and d²/dx² at x0.
+    y1, d1, s1 : float
+        Value, d/dx and d²/dx² at x1.
+
+    Returns
+    -------
+    float
+        The interpolant [units of y].
+    """
     t2 = t * t
     t3 = t2 * t
     t4 = t3 * t
@@ -45,6 +58,13 @@ def quintic_interval(x, x0, x1, y0, y1, d0, d1, s0, s1):
 
 
 @njit(cache=True)
+def quintic_interval(x, x0, x1, y0, y1, d0, d1, s0, s1):
+    """Quintic Hermite at ``x`` on [x0, x1] from values y, first derivatives d, second s."""
+    h = x1 - x0
+    return _quintic_value((x - x0) / h, h, y0, d0, s0, y1, d1, s1)
+
+
+@njit(cache=True)
 def quintic_unit(t, h, y0, d0, s0, y1, d1, s1):
     """(value, d/dx) of the quintic Hermite at t = (x - x0)/h in [0, 1], interval width h.
 
@@ -53,13 +73,7 @@ def quintic_unit(t, h, y0, d0, s0, y1, d1, s1):
     t2 = t * t
     t3 = t2 * t
     t4 = t3 * t
-    t5 = t4 * t
-    val = ((1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5) * y0
-           + (t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5) * h * d0
-           + 0.5 * (t2 - 3.0 * t3 + 3.0 * t4 - t5) * h * h * s0
-           + (10.0 * t3 - 15.0 * t4 + 6.0 * t5) * y1
-           + (-4.0 * t3 + 7.0 * t4 - 3.0 * t5) * h * d1
-           + 0.5 * (t3 - 2.0 * t4 + t5) * h * h * s1)
+    val = _quintic_value(t, h, y0, d0, s0, y1, d1, s1)
     der = ((-30.0 * t2 + 60.0 * t3 - 30.0 * t4) * y0
            + (1.0 - 18.0 * t2 + 32.0 * t3 - 15.0 * t4) * h * d0
            + 0.5 * (2.0 * t - 9.0 * t2 + 12.0 * t3 - 5.0 * t4) * h * h * s0

@@ -18,6 +18,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from ._index import clamp_index
 from .hermite import quintic_interval  # noqa: F401  (re-export, old home)
 
 __all__ = ["Grid", "quintic_interval", "build_bucket_map", "locate_desc",
@@ -82,12 +83,7 @@ def locate_desc(y, y_desc, b_lo, b_dz, b_idx):
     n = y_desc.size
     if y > y_desc[0] or y < y_desc[n - 1]:
         return -1
-    b = int((-y - b_lo) / b_dz)
-    if b < 0:
-        b = 0
-    if b > b_idx.size - 1:
-        b = b_idx.size - 1
-    i = b_idx[b]
+    i = b_idx[clamp_index(int((-y - b_lo) / b_dz), b_idx.size - 1)]
     while i < n - 2 and y_desc[i + 1] > y:
         i += 1
     return i
@@ -99,12 +95,7 @@ def locate_asc(y, y_asc, b_lo, b_dz, b_idx):
     n = y_asc.size
     if not (y_asc[0] <= y <= y_asc[n - 1]):
         return -1
-    b = int((y - b_lo) / b_dz)
-    if b < 0:
-        b = 0
-    if b > b_idx.size - 1:
-        b = b_idx.size - 1
-    i = b_idx[b]
+    i = b_idx[clamp_index(int((y - b_lo) / b_dz), b_idx.size - 1)]
     while i < n - 2 and y_asc[i + 1] < y:
         i += 1
     return i
