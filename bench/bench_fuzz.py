@@ -347,8 +347,29 @@ def squeeze_refs(tables, rng, n_ref, budget):
     return worst, done
 
 
+def uniform_ref_exact_width(psd, *, p0, dp, L, L_y, E_star, eta, theory, p_b=0.0):
+    """Q of a flat ring with the interval [c - dp, c], c = p0 - p_b, of exact width dp.
+
+    ``tests/reference/seal_reference.uniform_reference`` forms the lower limit as
+    p0 - (p_b + dp), which loses the width to cancellation when dp/p0 is below ~1e-8 (its
+    relative error is ~1e-16 p0/dp). For dp <= 1e-3 c this integrates σ_eff directly on
+    Gauss–Legendre nodes c - dp (1 - z)/2 (16 nodes, the width enters only as the factor
+    dp/2; σ_eff is smooth on such a short interval), σ_eff from the direct core."""
+    from reference.seal_reference import sigma_direct, uniform_reference
+    c = p0 - p_b
+    if dp == 0:
+        return 0.0
+    if dp > 1e-3 * c:
+        return uniform_reference(psd, p0=p0, dp=dp, L=L, L_y=L_y, E_star=E_star, eta=eta,
+                                 theory=theory, p_b=p_b)[0]
+    z, w = np.polynomial.legendre.leggauss(16)
+    p = c - 0.5 * dp * (1.0 - z)
+    s = sigma_direct(psd, p, E_star, eta, theory)
+    return L_y / L * 0.5 * dp * float(np.sum(w * s))
+
+
 def seal_refs(tables, rng, n_ref, budget):
-    from reference.seal_reference import SigmaInterp, hertz_reference, uniform_reference
+    from reference.seal_reference import SigmaInterp, hertz_reference
     from fastcontact.tables.defaults import default_surface
     worst = {}
     done = Counter()
@@ -374,8 +395,8 @@ def seal_refs(tables, rng, n_ref, budget):
                 L = 1e-3
                 got = float(seal_leak(tab, p0=p0, dp=dp, L=L, L_y=L_y, E_star=E, eta=eta,
                                       theory=theory, p_b=p_b)["Q"].iloc[0])
-                want, _ = uniform_reference(psd, p0=p0, dp=dp, L=L, L_y=L_y, E_star=E, eta=eta,
-                                            theory=theory, p_b=p_b)
+                want = uniform_ref_exact_width(psd, p0=p0, dp=dp, L=L, L_y=L_y, E_star=E,
+                                               eta=eta, theory=theory, p_b=p_b)
                 key = (theory, "uniform")
                 info = dict(table=name, p0=p0, dp=dp, p_b=p_b, E_star=E, got=got, ref=want)
             else:
