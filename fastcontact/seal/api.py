@@ -14,6 +14,7 @@ from ._inputs import (alpha_scale, check_tables, check_theory_for, common_inputs
                       hertz_contact, profile_kind, require)
 from .context import RowsOut, panel_rule, seal_context, solver_options
 from .hertz import VERIFY_TOL, table_W
+from .viscosity import seal_leak_piezo  # issue 14: Barus fluid (alpha_pv)
 
 __all__ = ["seal_leak", "columns", "STATUS", "UNITS", "REFERENCES", "EQUALITY_TOL"]
 
@@ -203,7 +204,7 @@ def _leak_array(sc, theory, p0x, x, com, alpha_cj, o):
 # =========================================================================== public
 def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory="critical_junction",
               alpha_cj=1.0, p_b=0.0, profile="uniform", R=None, f_N=None, x=None, a_perc=None,
-              solver=None):
+              solver=None, alpha_pv=0.0):
     """Leak rate of a static seal, Q = L_y q [m³/s], for many cases at once.
 
     Steady flow across the seal width with fluid-pressure feedback (Lorenz & Persson 2010,
@@ -243,6 +244,10 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory="critical
         If given it must equal the tables' percolation area fraction [-].
     solver : dict, optional
         Knobs of the non-uniform solver (``fastcontact.seal.SOLVER_DEFAULTS``).
+    alpha_pv : float or array_like, default 0.0
+        Barus pressure–viscosity coefficient α [1/Pa], η = η0 exp(α(p_f − p_b)); any non-zero
+        value dispatches to :func:`fastcontact.seal.viscosity.seal_leak_piezo` ("uniform" and
+        "hertz" profiles). 0 leaves this function's result unchanged.
 
     Returns
     -------
@@ -267,6 +272,10 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory="critical
     ----------
     B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10621-2
     """
+    if np.any(np.asarray(alpha_pv, dtype=np.float64) != 0.0):      # issue 14: Barus fluid
+        return seal_leak_piezo(tables, p0=p0, dp=dp, L=L, L_y=L_y, E_star=E_star, eta=eta,
+                               alpha_pv=alpha_pv, theory=theory, alpha_cj=alpha_cj, p_b=p_b,
+                               profile=profile, R=R, f_N=f_N)
     check_tables(tables)
     alpha_cj = check_theory_for(tables, theory, alpha_cj, a_perc)
     kind, p0x, xarr = profile_kind(profile, x)

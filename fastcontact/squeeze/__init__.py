@@ -19,6 +19,7 @@ from .api import (QUAD_ORDER, QUAD_WIDTH, STATUS_NAMES, columns, register_extens
 from .model import DEFAULT_P_START, TAIL_EXTENT, ModelPar, SqueezeModel, squeeze_model
 from .primitive import DXI as FAST_DXI
 from .primitive import set_primitive_cache
+from . import viscosity as _viscosity  # noqa: E402,F401  registers squeeze_out(alpha_pv=...) (issue 14)
 
 __all__ = ["squeeze_out", "squeeze_history", "squeeze_model", "columns", "SqueezeModel",
            "ModelPar", "DEFAULT_P_START", "QUAD_ORDER", "QUAD_WIDTH", "FAST_DXI", "TAIL_EXTENT",
