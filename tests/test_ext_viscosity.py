@@ -178,3 +178,13 @@ def test_squeeze_out_keyword(tables):
     assert got.equals(ref)
     with pytest.raises(ValueError, match="times"):
         squeeze_out(tables, alpha_pv=2e-6, times=(1e-3,), **kw)
+
+
+def test_seal_leak_keyword(tables):
+    """seal_leak(..., alpha_pv=): 0 → unchanged, > 0 → the Barus engine."""
+    kw = dict(p0=5e4, dp=np.array([1e4, 3e4]), L=5e-3, L_y=L_Y, E_star=E_STAR, eta=ETA,
+              theory="emt")
+    assert seal_leak(tables, **kw).equals(seal_leak(tables, alpha_pv=0.0, **kw))
+    got = seal_leak(tables, alpha_pv=1e-5, **kw)
+    ref = seal_leak_piezo(tables, alpha_pv=1e-5, **kw)
+    assert got.equals(ref)
