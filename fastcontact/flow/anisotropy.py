@@ -21,6 +21,9 @@ theory "critical_junction" (form "fixed" only): the junction sits where A(ζc)/A
 directional threshold, the isotropic a_perc mapped by its odds, a_x/(1 - a_x) =
 γ_T a_perc/(1 - a_perc). theory "average": σ = ū³/(12η) carries no direction (returned as is).
 γ_T = 1 returns the isotropic :func:`fastcontact.flow.conductivity.conductivity` exactly.
+Table path: :func:`precompute_directional` (σ̄_xx, σ̄_yy splines) and
+:func:`directional_tables` (an ordinary Tables whose "emt" columns are directional, so every
+engine runs the anisotropic case; the choice is recorded in its options/provenance).
 
 References: B.N.J. Persson, J. Phys.: Condens. Matter 22, 265004 (2010),
 doi:10.1088/0953-8984/22/26/265004; B.N.J. Persson, Eur. Phys. J. E 43, 25 (2020),
