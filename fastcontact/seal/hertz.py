@@ -18,7 +18,7 @@ from .context import RowsOut, panel_rule, solver_options
 __all__ = ["HertzTable", "hertz_table", "table_W", "H1", "NY", "TABLE_TOL", "VERIFY_TOL"]
 
 #: grid spacing in ln π_H, number of y intervals
-H1 = 0.1
+H1 = 0.05
 NY = 128
 #: solver panel tolerance of the table nodes, and the verification tolerance (in ln W)
 TABLE_TOL = 1e-7
