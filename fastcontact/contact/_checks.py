@@ -35,7 +35,8 @@ def _check_load(psd, p, E_star, p_name="p", p_unit="[Pa]"):
     Returns
     -------
     (ndarray, ndarray)
-        ``p`` and ``E_star`` as float arrays (see :func:`fastcontact._core.validate.check_positive`).
+        ``p`` and ``E_star`` as float arrays
+        (see :func:`fastcontact._core.validate.check_positive`).
     """
     _check_psd(psd)
     return check_positive(p_name, p, p_unit), check_positive("E_star", E_star, "[Pa]")

@@ -21,7 +21,8 @@ __all__ = ["stiffness_G", "area_fraction", "percolation_pressure", "critical_mag
 
 def _stiffness(psd, E_star, zeta):
     """G(ζ) [Pa²] (A2) of validated inputs (E_star [Pa] and ζ [-] broadcast)."""
-    return 0.25 * math.pi * E_star ** 2 * np.asarray(psd.moment(3.0, psd.q0, np.asarray(zeta) * psd.q0))
+    m3 = psd.moment(3.0, psd.q0, np.asarray(zeta) * psd.q0)
+    return 0.25 * math.pi * E_star ** 2 * np.asarray(m3)
 
 
 def stiffness_G(psd, E_star, zeta):

@@ -24,27 +24,7 @@ __all__ = ["mean_separation", "separation_slope", "u1", "contact_pressure", "asy
 
 
 def _reduced_inputs(psd, p, E_star, zeta, gamma):
-    """Validated inputs of the (A4)/(A3) kernels, broadcast over (p, E*, ζ) and flattened.
-
-    Parameters
-    ----------
-    psd : PSD
-        Roughness spectrum.
-    p : array_like
-        Nominal contact pressure [Pa], > 0.
-    E_star : float or array_like
-        Effective modulus [Pa], > 0.
-    zeta : array_like
-        Magnification in [1, ζ1] [-].
-    gamma : float
-        Yang–Persson factor in (0, 1] [-].
-
-    Returns
-    -------
-    (tuple, ndarray, ndarray, float)
-        Broadcast shape, reduced pressures p̄ = p/E* [-] and ζ [-] (flat, contiguous
-        float64), and γ.
-    """
+    """(shape, p̄ = p/E* [-], ζ [-], γ): the (A4) inputs checked, broadcast and flattened."""
     p, E_star = _check_load(psd, p, E_star)
     zeta = _check_zeta(psd, zeta)
     gamma = _check_gamma(gamma)
