@@ -15,16 +15,17 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from reference.ext_anisotropy import p_of_u, sigma_fixed, sigma_self_consistent
+from reference.ext_anisotropy import p_of_u, sigma_fixed, sigma_self_consistent  # noqa: E402
 
-import fastcontact as fc
-from fastcontact.flow.anisotropy import (
+import fastcontact as fc  # noqa: E402
+from fastcontact.flow.anisotropy import (  # noqa: E402
     directional_sigma_bar,
+    directional_tables,
     directional_threshold,
     precompute_directional,
     sigma_directional,
 )
-from fastcontact.flow.conductivity import conductivity
+from fastcontact.flow.conductivity import conductivity  # noqa: E402
 
 E_STAR = 1e7
 
