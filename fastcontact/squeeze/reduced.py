@@ -1,5 +1,5 @@
 """Reduced (asymptotic) squeeze-out model of Sec. 2 of the paper, the flat-surface Stefan
-law and the inertia-limited estimate of Sec. 5 (SPEC §4).
+law and the inertia-limited estimate of Sec. 5 (Lorenz & Persson 2010, doi:10.1140/epje/i2010-10626-9).
 
 The block (flat, radius R) is pressed with the nominal pressure p0 against a rigid
 randomly rough substrate in a Newtonian fluid. For large separations the asperity contact
@@ -323,7 +323,7 @@ def u_of_t_reduced(kappa, alpha, t, u_start=None):
 
 # =========================================================================== flat surfaces
 def flat_separation(u0, t, p0, eta, R):
-    """Film thickness between flat surfaces (Stefan–Reynolds law, SPEC §4) [m]:
+    """Film thickness between flat surfaces (Stefan–Reynolds law, eq. (1) with p_cont = 0) [m]:
 
         ū(t) = ū0 [1 + 4 ū0² p0 t / (3ηR²)]^{-1/2},
 

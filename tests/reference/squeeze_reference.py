@@ -131,6 +131,33 @@ class SqueezeReference:
         return self.time(self.v_inf + dv, v_start)
 
 
+    def v_at(self, t, v_start=None, tol=1e-12):
+        """v(t̃) from v_start (τ0 units): root of time(v, v_start) = t̃ in w = ln(v - v∞),
+        safeguarded Newton with dt̃/dw = the integrand (each step one scipy quad)."""
+        v_start = self.default_start() if v_start is None else v_start
+        if t <= 0.0:
+            return v_start
+        hi = math.log(v_start - self.v_inf) if math.isfinite(v_start) else math.log(1e6)
+        lo = hi - 2.0
+        while self.time(self.v_inf + math.exp(lo), v_start) < t:
+            hi, lo = lo, lo - 4.0
+        w = 0.5 * (lo + hi)
+        for _ in range(60):
+            f = self.time(self.v_inf + math.exp(w), v_start) - t
+            if f > 0.0:
+                lo = w
+            else:
+                hi = w
+            wn = w + f / self._f(w)  # dt/dw = -integrand: t decreases with w
+            if not (lo < wn < hi):
+                wn = 0.5 * (lo + hi)
+            if abs(wn - w) < tol or hi - lo < tol:
+                w = wn
+                break
+            w = wn
+        return self.v_inf + math.exp(w)
+
+
 def tau0(eta, R, h_rms, p0):
     """τ0 = 3ηR²/(2 h_rms² p0) [s]."""
     return 3.0 * eta * R * R / (2.0 * h_rms * h_rms * p0)

@@ -1,0 +1,195 @@
+"""Issue 11 points 1, 5, 6 and issue 15.1: the time primitive behind ``method="fast"``.
+
+Accuracy against the independent direct-core reference (tests/reference/squeeze_reference.py:
+scipy quad + brentq, no tables), agreement with the per-case quadrature on random cases
+with per-case starts, Δu targets and times, the invariants (times >= 0, exactly 0 for
+passed targets, ū(t) monotone, every NaN/inf explained by ``status``), exact column names,
+and the primitive's Parquet cache.
+"""
+from __future__ import annotations
+
+import math
+import os
+import sys
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reference.squeeze_reference import SqueezeReference, tau0  # noqa: E402
+
+from fastcontact._core.vocab import column_name  # noqa: E402
+from fastcontact.squeeze import set_primitive_cache, squeeze_history, squeeze_model, squeeze_out  # noqa: E402
+from fastcontact.squeeze import primitive as prim  # noqa: E402
+from fastcontact.tables import Tables  # noqa: E402
+from fastcontact.tables.defaults import default_table_path  # noqa: E402
+
+E = 13e6
+ETA = 1e-3
+R = 0.02
+
+
+@pytest.fixture(scope="module")
+def T():
+    return Tables.from_parquet(default_table_path("asphalt_024mm"))
+
+
+def _rel(a, b):
+    return abs(a / b - 1.0)
+
+
+# ------------------------------------------------------------------ vs the reference
+@pytest.mark.parametrize("theory,p0", [("average", 0.2e6), ("critical_junction", 2e4)])
+def test_given_start_targets_and_times_vs_reference(T, theory, p0):
+    h = T.h_rms
+    ref = SqueezeReference(T.surface, E, theory, p0)
+    tau = tau0(ETA, R, h, p0)
+    vs = 3.0 * ref.v_inf
+    t_ref = ref.t_ratio(1.01, v_start=vs)
+    # ū at a time: one brentq solve on the reference quadrature (slow: average theory only)
+    times = np.array([0.5]) * t_ref * tau if theory == "average" else np.zeros(0)
+    df = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, theory=theory, u_start=vs * h,
+                     ratios=(1.1, 1.001), du=(0.05 * ref.v_inf * h,), times=times)
+    row = df.iloc[0]
+    assert row["status"] == "ok"
+    assert _rel(row["t_star"] / tau, t_ref) < 1e-6
+    assert _rel(row["t_ratio_1.1"] / tau, ref.t_ratio(1.1, v_start=vs)) < 1e-6
+    assert _rel(row["t_ratio_1.001"] / tau, ref.t_ratio(1.001, v_start=vs)) < 1e-6
+    assert _rel(row[column_name("t_du", 0.05 * ref.v_inf * h)] / tau,
+                ref.t_du(0.05 * ref.v_inf, v_start=vs)) < 1e-6
+    for t in times:
+        v_ref = ref.v_at(t / tau, v_start=vs)
+        got = row[column_name("u_at", t)] / h
+        err = abs((got - row["u_inf"] / h) - (v_ref - ref.v_inf))
+        assert err <= max(1e-6 * (v_ref - ref.v_inf), 1e-8 * ref.v_inf), (t, got, v_ref)
+
+
+def test_tire_exit_vs_reference(T):
+    from fastcontact.tire import tire_footprint
+    p0, u0 = 0.2e6, 2e-3
+    h = T.h_rms
+    ref = SqueezeReference(T.surface, E, "average", p0)
+    tau = tau0(ETA, R, h, p0)
+    t_half = ref.t_ratio(1.5, v_start=u0 / h) * tau
+    df = tire_footprint(T, p0=p0, E_star=E, R=R, eta=ETA, footprint_length=np.array([1.0]) * t_half,
+                        speed=1.0, u_start=u0, method="fast")
+    for k, f in enumerate((1.0,)):
+        v_ref = ref.v_at(f * t_half / tau, v_start=u0 / h)
+        du = df["u_exit"].iloc[k] / h - df["u_inf"].iloc[k] / h
+        assert abs(du - (v_ref - ref.v_inf)) <= max(1e-6 * (v_ref - ref.v_inf), 1e-8 * ref.v_inf)
+
+
+# ------------------------------------------------------------------ vs the quadrature
+@pytest.mark.parametrize("theory", ["average", "critical_junction", "emt"])
+def test_fast_matches_quad_per_case_start_du_times(T, theory):
+    rng = np.random.default_rng(3)
+    m = squeeze_model(T, theory)
+    top = min(math.exp(prim.fast_limit(m)), T.p_range[1])
+    n = 40
+    pis = np.exp(rng.uniform(math.log(T.p_range[0] * 1.0001), math.log(top), n))
+    p0 = pis * E
+    base = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, theory=theory, ratios=())
+    us = base["u_inf"].to_numpy() * np.exp(rng.uniform(0.01, 4.0, n))
+    times = np.array([1e-9, 1e-6, 1e-3, 1.0, 1e3])
+    kw = dict(p0=p0, E_star=E, R=R, eta=ETA, theory=theory, u_start=us, du=(1e-6, 1e-4),
+              times=times)
+    f = squeeze_out(T, **kw)
+    q = squeeze_out(T, **kw, method="quad", quad_order=20, quad_width=0.25)
+    assert (f["status"] == "ok").all() and (q["status"] == "ok").all()
+    for c in f.columns:
+        if c.startswith("t_"):
+            a, b = f[c].to_numpy(), q[c].to_numpy()
+            ok = (a == b) | (np.abs(a - b) <= 1e-6 * np.abs(b))
+            assert ok.all(), (theory, c, np.max(np.abs(a / b - 1)))
+    ui = q["u_inf"].to_numpy()
+    assert np.all(np.abs(f["u_inf"].to_numpy() / ui - 1) < 1e-8)
+    for t in times:
+        c = column_name("u_at", t)
+        a, b = f[c].to_numpy() - ui, q[c].to_numpy() - ui
+        assert np.all(np.abs(a - b) <= np.maximum(1e-6 * np.abs(b), 1e-8 * ui)), (theory, t)
+
+
+# ------------------------------------------------------------------ invariants
+def test_passed_targets_are_exactly_zero_and_times_nonnegative(T):
+    p0 = np.geomspace(1e3, 1e6, 50)
+    base = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, ratios=())
+    us = 1.05 * base["u_inf"].to_numpy()  # between the ratios 1.1 and 1.01
+    df = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, u_start=us, ratios=(10.0, 1.1, 1.01),
+                     du=(1.0,))
+    assert (df["t_ratio_10"] == 0.0).all() and (df["t_ratio_1.1"] == 0.0).all()
+    assert (df["t_du_1"] == 0.0).all()
+    assert (df["t_ratio_1.01"] > 0).all()
+    # default start: a target far above it is passed at t = 0 too
+    d = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, ratios=(1e6,))
+    assert (d[column_name("t_ratio", 1e6)] == 0.0).all()
+
+
+@pytest.mark.parametrize("theory", ["average", "critical_junction", "emt"])
+def test_history_monotone(T, theory):
+    t = np.concatenate([[0.0], np.geomspace(1e-12, 1e12, 3000), [np.inf]])
+    for p0 in (1e3, 1e5, 1e6):
+        h = squeeze_history(T, p0, E, R, ETA, theory, t=t)
+        u = h["u"].to_numpy()
+        assert np.all(np.isfinite(u)) and np.all(np.diff(u) <= 0)
+        assert u[0] == h.attrs["u_start"]
+        floor = h.attrs["u_trap"] if h.attrs["trapped"] else h.attrs["u_inf"]
+        assert u[-1] == pytest.approx(floor, rel=1e-12) and np.all(u >= floor * (1 - 1e-12))
+
+
+def test_bad_rows_do_not_sink_the_batch(T):
+    lo, hi = T.p_range
+    p0 = np.array([1e5, 0.5 * lo * E, 1e5, 2 * hi * E, 1e5])
+    R_ = np.array([R, R, 1e308, R, R])
+    us = np.array([1e-2, 1e-2, 1e-2, 1e-2, 1e-9])  # last row starts below equilibrium
+    df = squeeze_out(T, p0=p0, E_star=E, R=R_, eta=ETA, u_start=us, times=(1e-3,))
+    assert list(df["status"]) == ["ok", "out_of_table", "overflow", "out_of_table",
+                                  "start_below_equilibrium"]
+    one = squeeze_out(T, p0=1e5, E_star=E, R=R, eta=ETA, u_start=1e-2, times=(1e-3,))
+    num = [c for c in df.columns if df[c].dtype.kind == "f"]
+    np.testing.assert_array_equal(df.iloc[0][num].to_numpy(float), one.iloc[0][num].to_numpy(float))
+    for i in (1, 3, 4):
+        assert np.isnan(df["t_star"].iloc[i]) and np.isnan(df[column_name("u_at", 1e-3)].iloc[i])
+    assert np.isinf(df["t_star"].iloc[2]) and not df["trapped"].iloc[2]
+    # every non-finite time sits on a row whose status explains it
+    for c in ("t_star", "t_ratio_1.1", column_name("u_at", 1e-3), "u_inf"):
+        bad = ~np.isfinite(df[c].to_numpy())
+        assert (df.loc[bad, "status"] != "ok").all(), c
+
+
+def test_column_names_exact_unique_and_duplicates_refused(T):
+    df = squeeze_out(T, p0=1e5, E_star=E, R=R, eta=ETA, ratios=(1.0000001, 1.0000002),
+                     times=(0.1, 0.30000000000000004))
+    names = [c for c in df.columns if c.startswith("t_ratio_")]
+    assert len(names) == 2 and all(float(c[len("t_ratio_"):]) in (1.0000001, 1.0000002)
+                                   for c in names)
+    assert len([c for c in df.columns if c.startswith("u_at_")]) == 2
+    with pytest.raises(ValueError, match="ratio"):
+        squeeze_out(T, p0=1e5, E_star=E, R=R, eta=ETA, ratios=(1.1, 1.1))
+    assert set(df.attrs["units"]) == set(df.columns)
+    assert df.attrs["theory"] == "average" and any("Eur. Phys. J. E 32, 281" in r for r in df.attrs["references"])
+
+
+# ------------------------------------------------------------------ storage
+def test_primitive_measured_error_and_parquet_cache(T, tmp_path):
+    pr, info = prim.build(squeeze_model(T, "critical_junction"), check=True)
+    assert info["max_rel_err_T"] < 1e-6 and info["checked_points"] > 1000
+    a = Tables.from_parquet(default_table_path("asphalt_024mm"))
+    set_primitive_cache(a, tmp_path)
+    ra = squeeze_out(a, p0=np.geomspace(1e3, 1e6, 20), E_star=E, R=R, eta=ETA,
+                     theory="critical_junction", times=(1e-4,))
+    files = list(tmp_path.glob("squeeze_primitive_critical_junction_*.parquet"))
+    assert len(files) == 1
+    b = Tables.from_parquet(default_table_path("asphalt_024mm"))
+    set_primitive_cache(b, tmp_path)
+    m = squeeze_model(b, "critical_junction")
+    rb = squeeze_out(b, p0=np.geomspace(1e3, 1e6, 20), E_star=E, R=R, eta=ETA,
+                     theory="critical_junction", times=(1e-4,))
+    assert m.primitive_info["max_rel_err_T"] < 1e-6  # read from the file's metadata
+    num = [c for c in ra.columns if ra[c].dtype.kind == "f"]
+    np.testing.assert_array_equal(ra[num].to_numpy(), rb[num].to_numpy())
+    files[0].write_bytes(b"not parquet")  # a damaged file is rebuilt, not trusted
+    c = Tables.from_parquet(default_table_path("asphalt_024mm"))
+    set_primitive_cache(c, tmp_path)
+    rc = squeeze_out(c, p0=np.geomspace(1e3, 1e6, 20), E_star=E, R=R, eta=ETA,
+                     theory="critical_junction", times=(1e-4,))
+    np.testing.assert_array_equal(ra[num].to_numpy(), rc[num].to_numpy())
