@@ -100,6 +100,10 @@ def _add_tables_parser(sub):
     tb.add_argument("--gamma", type=float, default=1.0, help="Yang-Persson factor (1 = paper)")
     tb.add_argument("--a-perc", type=float, default=0.5, help="percolation threshold A/A0")
     tb.add_argument("--alpha-cj", type=float, default=1.0, help="critical-junction factor")
+    tb.add_argument("--emt-threshold", type=float, default=0.5,
+                    help="effective-medium percolation threshold A/A0 (0.5 = 2-D Bruggeman)")
+    tb.add_argument("--calibration", help="calibration TOML file (fastcontact bem calibrate): "
+                                          "sets gamma, a_perc, alpha_cj, emt_threshold")
     tb.add_argument("-o", "--output", required=True, help="output .parquet file")
     ti = tsub.add_parser("info", help="show a table file's metadata")
     ti.add_argument("file", help="tables .parquet file")
@@ -238,6 +242,13 @@ def _split_theories(vals):
     return out
 
 
+def _existing_file(path, option):
+    """``path`` if it is a file, else CLIError naming the option."""
+    if not Path(path).is_file():
+        raise CLIError(f"fastcontact tables build: {option} {str(path)!r}: file not found")
+    return Path(path)
+
+
 def _cmd_tables_build(a, out, err):
     from .tables import precompute
     sa = {"--h-rms": a.h_rms, "--hurst": a.hurst, "--q0": a.q0, "--q1": a.q1}
@@ -265,8 +276,12 @@ def _cmd_tables_build(a, out, err):
     print(f"building tables for {psd!r}, theories {theories} ...", file=err)
     with Progress(1, True, err) as prog:
         prog.step("tabulating")
+        cal = None
+        if a.calibration is not None:
+            from .validation.calibration import Calibration
+            cal = Calibration.from_toml(_existing_file(a.calibration, "--calibration"))
         T = precompute(psd, theories=theories, gamma=a.gamma, a_perc=a.a_perc,
-                       alpha_cj=a.alpha_cj)
+                       alpha_cj=a.alpha_cj, emt_threshold=a.emt_threshold, calibration=cal)
         prog.advance()
     T.to_parquet(a.output)
     print(f"wrote {a.output} ({T.info['nodes']} nodes, {T.info['build_seconds']:.2f} s)", file=out)

@@ -244,3 +244,23 @@ def test_reading_a_calibration_needs_no_bem_extra(tmp_path, cal):
             "assert s.table_options['emt_threshold'] == 0.42, s.table_options; "
             "assert 'ContactMechanics' not in [m for m in sys.modules if sys.modules[m]]")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+# --------------------------------------------------------------------------- CLI
+def test_cli_tables_build_with_calibration(cal, tmp_path):
+    import io
+    from fastcontact.cli import main
+    cal.to_toml(tmp_path / "cal.toml")
+    args = ["tables", "build", "--h-rms", "1e-6", "--hurst", "0.8", "--q0", repr(Q0),
+            "--q1", repr(32 * Q0), "--q-roll", repr(4 * Q0), "--theories", "emt"]
+    out, err = io.StringIO(), io.StringIO()
+    code = main(args + ["--calibration", str(tmp_path / "cal.toml"), "-o",
+                        str(tmp_path / "t.parquet")], out=out, err=err)
+    assert code == 0, err.getvalue()
+    T = Tables.from_parquet(tmp_path / "t.parquet")
+    assert T.options["emt_threshold"] == 0.42 and T.info["calibration"]["gamma"] == 0.8
+    out, err = io.StringIO(), io.StringIO()
+    code = main(args + ["--calibration", str(tmp_path / "cal.toml"), "--emt-threshold", "0.45",
+                        "-o", str(tmp_path / "u.parquet")], out=out, err=err)
+    assert code != 0 and "emt_threshold = 0.45" in err.getvalue()
+    assert not (tmp_path / "u.parquet").exists()
