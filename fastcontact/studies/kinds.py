@@ -28,7 +28,7 @@ _SQUEEZE_INPUTS = ("p0", "E_star", "R", "eta")
 #: further squeeze_out columns offered by squeeze studies (as the engine lists them)
 SQUEEZE_TAIL = tuple(c for c in squeeze_engine_columns((), (), ())
                      if c not in _SQUEEZE_INPUTS + ("u_start", "u_inf", "t_star"))
-SEAL_COLUMNS = ("Q", "lift_off", "percolated", "p_a", "open_inlet", "open_outlet")
+SEAL_COLUMNS = ("Q", "lift_off", "percolated", "p_a", "open_inlet", "open_outlet", "status")
 SEAL_HERTZ_COLUMNS = ("a", "L", "p_max", "converged", "error_estimate")
 #: boolean result columns (nullable booleans where a case failed)
 BOOL_COLUMNS = frozenset({"trapped", "percolated", "out_of_table", "squeeze_complete",
