@@ -172,7 +172,7 @@ def test_column_names_exact_unique_and_duplicates_refused(T):
 # ------------------------------------------------------------------ storage
 def test_primitive_measured_error_and_parquet_cache(T, tmp_path):
     pr, info = prim.build(squeeze_model(T, "critical_junction"), check=True)
-    assert info["max_rel_err_T"] < 1e-6 and info["checked_points"] > 1000
+    assert info["max_rel_err_T"] < 2e-6 and info["checked_points"] > 1000
     a = Tables.from_parquet(default_table_path("asphalt_024mm"))
     set_primitive_cache(a, tmp_path)
     ra = squeeze_out(a, p0=np.geomspace(1e3, 1e6, 20), E_star=E, R=R, eta=ETA,
@@ -184,7 +184,7 @@ def test_primitive_measured_error_and_parquet_cache(T, tmp_path):
     m = squeeze_model(b, "critical_junction")
     rb = squeeze_out(b, p0=np.geomspace(1e3, 1e6, 20), E_star=E, R=R, eta=ETA,
                      theory="critical_junction", times=(1e-4,))
-    assert m.primitive_info["max_rel_err_T"] < 1e-6  # read from the file's metadata
+    assert m.primitive_info["max_rel_err_T"] < 2e-6  # read from the file's metadata
     num = [c for c in ra.columns if ra[c].dtype.kind == "f"]
     np.testing.assert_array_equal(ra[num].to_numpy(), rb[num].to_numpy())
     files[0].write_bytes(b"not parquet")  # a damaged file is rebuilt, not trusted

@@ -487,17 +487,22 @@ X_END = 0.005
 X_FALLBACK = 0.01
 
 
+def _kink(model):
+    """ln p̄ of the tables' last node with σ̄ > 0: beyond it σ̄^(1/3) is linear to the exact
+    percolation pressure, so ln σ̄ has a kink there that no smooth grid may straddle."""
+    lnp, n_open = model.tab[0], int(model.tab[6])
+    return float(lnp[n_open - 1]) if n_open < lnp.size else math.inf
+
+
 def fast_limit(model):
     """Largest ln(p0/E*) the primitive serves (above: per-case quadrature)."""
-    if np.isfinite(model.x_trap):
-        return min(model.x_trap - X_FALLBACK, model.x_max)
-    return model.x_max
+    lim = min(model.x_trap - X_FALLBACK, _kink(model) - 2 * X_FALLBACK)
+    return min(lim, model.x_max)
 
 
 def _x_nodes(model, dxi):
     """x0 nodes uniform in ξ = x0 - ln σ̄(x0) on [x_min, x_hi]."""
-    x_hi = model.x_trap - X_END if np.isfinite(model.x_trap) else model.x_max
-    x_hi = min(x_hi, model.x_max)
+    x_hi = min(model.x_trap - X_END, _kink(model) - X_END, model.x_max)
     xs = np.linspace(model.x_min, x_hi, 20001)
     sig = np.empty(xs.size)
     qk.sigma_kernel(model.tab, xs, sig)
@@ -539,8 +544,8 @@ def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, order=NODE_ORDER, check=True):
 def measure_error(model, pr, pf, n_x=64, order=NODE_ORDER):
     """Max relative error of the interpolated T at cell centres (n_x x0 cells × all z cells)."""
     rng = np.random.default_rng(0)
-    nx = pr.xn.size
-    cells = np.unique(rng.integers(0, nx - 1, n_x))
+    served = int(np.searchsorted(pr.xn, fast_limit(model), side="right")) - 1
+    cells = np.unique(rng.integers(0, max(served, 1), n_x))  # cells the fast path serves
     xm = 0.5 * (pr.xn[cells] + pr.xn[cells + 1])
     zc = pr.z0 + (np.arange(pr.nz - 1) + 0.5) * pr.dz
     X, Z = np.meshgrid(xm, zc, indexing="ij")
