@@ -48,7 +48,7 @@ def profile_kind(profile, x):
             raise ValueError(f"x = array(...) is invalid with profile = {profile!r}: x gives the "
                              f"positions of an array profile only")
         return profile, None, None
-    p = as_float_array("profile", profile)
+    p = as_float_array("profile", profile, "[Pa]")
     if p.ndim != 1 or p.size < 2:
         raise ValueError(f"profile = array(shape={p.shape}) is invalid: must be 'uniform', 'hertz' "
                          f"or a 1-D array of at least 2 values of p0(x) [Pa]")
@@ -56,7 +56,7 @@ def profile_kind(profile, x):
     if x is None:
         raise ValueError("x = None is invalid with an array profile: give the positions x [m] "
                          "of the p0(x) samples")
-    xa = as_float_array("x", x)
+    xa = as_float_array("x", x, "[m]")
     if xa.shape != p.shape:
         raise ValueError(f"x = array(shape={xa.shape}) is invalid: must have the profile's shape "
                          f"{p.shape}")

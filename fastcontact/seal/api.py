@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .._core.validate import check_positive
+from .._core.validate import align_inputs, check_positive
 from . import _panels, _sigma
 from ._inputs import (alpha_scale, check_tables, check_theory_for, common_inputs, forbid,
                       hertz_contact, profile_kind, require)
@@ -277,6 +277,10 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory="critical
                                alpha_pv=alpha_pv, theory=theory, alpha_cj=alpha_cj, p_b=p_b,
                                profile=profile, R=R, f_N=f_N)
     check_tables(tables)
+    al = align_inputs(p0=p0, dp=dp, L=L, L_y=L_y, E_star=E_star, eta=eta, p_b=p_b, R=R,
+                      f_N=f_N)                               # pandas inputs paired by label
+    p0, dp, L, L_y, E_star, eta, p_b, R, f_N = (al[k] for k in ("p0", "dp", "L", "L_y", "E_star",
+                                                                 "eta", "p_b", "R", "f_N"))
     alpha_cj = check_theory_for(tables, theory, alpha_cj, a_perc)
     kind, p0x, xarr = profile_kind(profile, x)
     com = common_inputs(dp, L_y, E_star, eta, p_b)

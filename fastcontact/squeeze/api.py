@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from .._core.validate import as_float_array, check_positive
+from .._core.validate import align_inputs, as_float_array, check_positive
 from .._core.vocab import REFERENCES, column_name
 from ..tables import Tables
 from . import _kernels as qk
@@ -223,6 +223,8 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory="average", u_start=None,
     ----------
     B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10626-9.
     """
+    al = align_inputs(p0=p0, E_star=E_star, R=R, eta=eta, u_start=u_start)  # pandas: by label
+    p0, E_star, R, eta, u_start = (al[k] for k in ("p0", "E_star", "R", "eta", "u_start"))
     if extensions:
         name = next(iter(extensions))
         if name not in _EXTENSIONS:
