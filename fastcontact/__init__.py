@@ -27,6 +27,7 @@ _LAZY = {
     "SelfAffinePSD": "surface.psd", "TabulatedPSD": "surface.psd", "PSD": "surface.psd",
     "read_psd": "surface.topography", "write_psd": "surface.topography",
     "psd_from_heights": "surface.topography", "synthetic_heights": "surface.topography",
+    "read_topography": "surface.io", "psd_from_surface_topography": "surface.io",
     "effective_modulus": "contact.elasticity",
     "precompute": "tables", "Tables": "tables", "load_default_tables": "tables.defaults",
     "squeeze_out": "squeeze", "squeeze_history": "squeeze", "squeeze_out_reduced": "squeeze.reduced",
