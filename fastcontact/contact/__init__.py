@@ -16,7 +16,7 @@ u1(ζ)    separation of the surfaces that come into contact at ζ [m]      (A3)
 u0, β    asymptote p ≈ β E* exp(-ū/u0) [m], [-]                          (3)
 
 References: B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010),
-doi:10.1140/epje/i2010-10626-9; B.N.J. Persson, J. Chem. Phys. 115, 3840 (2001),
+arXiv:1004.1037; B.N.J. Persson, J. Chem. Phys. 115, 3840 (2001),
 doi:10.1063/1.1388626.
 """
 from __future__ import annotations

@@ -25,7 +25,7 @@ with ``F(s) = (γ/2) E1(s²) + 3(1-γ) K(s)`` and ``g(s) = [γ + 3(1-γ) erf²(s
 ``u1(ζ) = I_F + I_g + k(ζ) (A/A') J`` with ``k = (π/2) q0 (ζq0)³ C(ζq0)``.
 
 References: B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010),
-doi:10.1140/epje/i2010-10626-9; C. Yang and B.N.J. Persson, J. Phys.: Condens. Matter 20,
+arXiv:1004.1037; C. Yang and B.N.J. Persson, J. Phys.: Condens. Matter 20,
 215214 (2008), doi:10.1088/0953-8984/20/21/215214.
 """
 from __future__ import annotations

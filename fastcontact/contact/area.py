@@ -2,7 +2,7 @@
 
 ``G(ζ) = (π/4) E*² ∫_{q0}^{ζq0} q³ C(q) dq`` and ``A(ζ)/A0 = erf(p / (2√G(ζ)))``
 (B.N.J. Persson, J. Chem. Phys. 115, 3840 (2001), doi:10.1063/1.1388626; B. Lorenz and
-B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10626-9, App. A).
+B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037, App. A).
 """
 from __future__ import annotations
 

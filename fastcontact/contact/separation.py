@@ -1,7 +1,7 @@
 """Mean interfacial separation ū(ζ) (A4), u1(ζ) (A3), its inverse p_cont(ū) and the asymptote (3).
 
 All by direct quadrature (:mod:`._kernels`), relative accuracy ~1e-10. B. Lorenz and
-B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10626-9; the γ ≠ 1
+B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037; the γ ≠ 1
 form is C. Yang and B.N.J. Persson, J. Phys.: Condens. Matter 20, 215214 (2008),
 doi:10.1088/0953-8984/20/21/215214.
 """

@@ -6,7 +6,7 @@ towards both ends (t -> A = A1 + (1-A1) t³/(t³+(1-t)³)), with adaptive 7/15 G
 panels: the panel with the largest Kronrod–Gauss difference of the Bruggeman residual is split
 until the estimated relative error of σ̄ is below ``tol``. u1 is evaluated where A(ζ) equals
 each node exactly; nodes where dA/dζ underflows get u1 = ∞ and weight 0 (masked).
-B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 31, 159 (2010), doi:10.1140/epje/i2010-10558-6.
+B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019.
 """
 from __future__ import annotations
 

@@ -13,7 +13,7 @@ effective medium when A(ζ1)/A0 >= emt_threshold (0.5: 2-D Bruggeman; other valu
 generalized medium of Kirkpatrick, Rev. Mod. Phys. 45, 574 (1973), doi:10.1103/RevModPhys.45.574).
 Every result carries a ``percolated`` flag.
 References: B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010),
-doi:10.1140/epje/i2010-10626-9 and Eur. Phys. J. E 31, 159 (2010), doi:10.1140/epje/i2010-10558-6.
+arXiv:1004.1037 and Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019.
 """
 from __future__ import annotations
 

@@ -32,7 +32,7 @@ REFERENCES = (
     "B. Lorenz and B.N.J. Persson, Fluid squeeze-out between solids with rough surfaces, "
     "Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10621-2",
     "B. Lorenz and B.N.J. Persson, Leak rate of seals: effective-medium theory and comparison "
-    "with experiment, Eur. Phys. J. E 31, 159 (2010), doi:10.1140/epje/i2010-10558-6",
+    "with experiment, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019",
 )
 
 #: panel tolerance at the exact lift-off point p_a = max p0 (degenerate inlet end, where the

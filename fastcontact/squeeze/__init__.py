@@ -2,7 +2,7 @@
 :class:`~fastcontact.tables.Tables` — millions of cases per call.
 
 The film obeys dū/dt = -(8σ_eff/R²)(p0 - p_cont(ū)) (Lorenz & Persson, Eur. Phys. J. E 32,
-281 (2010), eqs. (17)–(19); doi:10.1140/epje/i2010-10626-9). In reduced units
+281 (2010), eqs. (17)–(19); arXiv:1004.1037). In reduced units
 (v = ū/h_rms, π = p/E*, σ̄ = 12ησ_eff/h_rms³, eq. (23); t = τ0 t̃, τ0 = 3ηR²/(2h_rms²p0)) the
 right-hand side depends on v only, so every time is a difference of one function, the time
 primitive T(p0/E*, ū), tabulated once per (tables, theory) (:mod:`.primitive`).

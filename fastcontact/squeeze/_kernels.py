@@ -3,7 +3,7 @@ the fast path for trapped-fluid rows).
 
 Reduced units: v = ū/h_rms, π = p/E*, σ̄ = 12ησ_eff/h_rms³, t̃ = t/τ0 with
 τ0 = 3ηR²/(2 h_rms² p0); dv/dt̃ = -σ̄(π_c(v)) (1 - π_c(v)/π0) (Lorenz & Persson 2010,
-eqs. (18), (19), (23); doi:10.1140/epje/i2010-10626-9). Times are quadratures in
+eqs. (18), (19), (23); arXiv:1004.1037). Times are quadratures in
 w = ln(v - v_b), never time stepping. Every kernel takes the tables' kernel record ``tab``
 and the model record ``mp`` (:class:`~fastcontact.squeeze.model.ModelPar`).
 """

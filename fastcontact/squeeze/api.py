@@ -2,7 +2,7 @@
 :func:`squeeze_history` (one case on a time array) and :func:`columns` (names and units).
 
 Lorenz & Persson, Eur. Phys. J. E 32, 281 (2010), eqs. (17)–(19), (23);
-doi:10.1140/epje/i2010-10626-9.
+arXiv:1004.1037.
 """
 from __future__ import annotations
 
@@ -221,7 +221,7 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory="average", u_start=None,
 
     References
     ----------
-    B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10626-9.
+    B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037.
     """
     al = align_inputs(p0=p0, E_star=E_star, R=R, eta=eta, u_start=u_start)  # pandas: by label
     p0, E_star, R, eta, u_start = (al[k] for k in ("p0", "E_star", "R", "eta", "u_start"))

@@ -146,7 +146,7 @@ def asperity_levels(psd, *, p0, E_star, R, eta, theory="emt", level_ratio=2.0, z
     out.attrs.update({"units": units, "theory": theory, "level_ratio": lr,
                       "zeta_trap": float(trapped.iloc[0]) if trapped.size else math.inf,
                       "region_rule": getattr(region, "__name__", repr(region)),
-                      "references": ["doi:10.1140/epje/i2010-10626-9",
+                      "references": ["arXiv:1004.1037",
                                      "doi:10.1016/j.surfrep.2006.04.001"]})
     return out
 

@@ -2,7 +2,7 @@
 criterion, default start, and the cached time primitive.
 
 Lorenz & Persson, Eur. Phys. J. E 32, 281 (2010), eqs. (3), (17)–(19), (23);
-doi:10.1140/epje/i2010-10626-9.
+arXiv:1004.1037.
 """
 from __future__ import annotations
 

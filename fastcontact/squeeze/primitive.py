@@ -1,7 +1,7 @@
 """The time primitive of one (tables, theory): every squeeze-out time is a difference of it.
 
 The squeeze-out ODE dv/dt̃ = -σ̄(π_c(v)) (1 - π_c(v)/π0) (Lorenz & Persson 2010, eqs. (18),
-(19), (23); doi:10.1140/epje/i2010-10626-9) is autonomous, so with
+(19), (23); arXiv:1004.1037) is autonomous, so with
 
     T(x0, v) = ∫_v^∞ dv' / (σ̄(π_c(v')) (1 - π_c(v')/π0)),      x0 = ln π0 = ln(p0/E*),
 

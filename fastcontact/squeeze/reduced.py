@@ -1,5 +1,5 @@
 """Reduced (asymptotic) squeeze-out model of Sec. 2 of the paper, the flat-surface Stefan
-law and the inertia-limited estimate of Sec. 5 (Lorenz & Persson 2010, doi:10.1140/epje/i2010-10626-9).
+law and the inertia-limited estimate of Sec. 5 (Lorenz & Persson 2010, arXiv:1004.1037).
 
 The block (flat, radius R) is pressed with the nominal pressure p0 against a rigid
 randomly rough substrate in a Newtonian fluid. For large separations the asperity contact

@@ -197,7 +197,7 @@ class SelfAffinePSD(PSD):
     B.N.J. Persson, O. Albohr, U. Tartaglino, A.I. Volokitin, E. Tosatti, J. Phys.: Condens.
     Matter 17, R1 (2005), doi:10.1088/0953-8984/17/1/R01 (self-affine spectra with roll-off);
     B. Lorenz & B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), App. A,
-    doi:10.1140/epje/i2010-10626-9 (the convention of C).
+    arXiv:1004.1037 (the convention of C).
     """
 
     def __init__(self, h_rms, hurst, q0, q1, q_roll=None):

@@ -9,7 +9,7 @@ scans → 2-D C: :mod:`fastcontact.surface.abel`; files: :mod:`fastcontact.surfa
 
 Conventions: ``C(q) = (2π)⁻² ∫ d²x ⟨h(x)h(0)⟩ e^{-iq·x}``, ``h_rms² = 2π ∫ q C dq``
 (B. Lorenz & B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), App. A,
-doi:10.1140/epje/i2010-10626-9); line scans ``C1D(q) = (2π)⁻¹ ∫ dx ⟨h(x)h(0)⟩ e^{-iqx}``,
+arXiv:1004.1037); line scans ``C1D(q) = (2π)⁻¹ ∫ dx ⟨h(x)h(0)⟩ e^{-iqx}``,
 ``h_rms² = 2 ∫_0^∞ C1D dq``. SurfaceTopography / contact.engineering use (2π)² C (2-D) and
 2π C1D (1-D) (T.D.B. Jacobs, T. Junge, L. Pastewka, Surf. Topogr. Metrol. Prop. 5, 013001
 (2017), doi:10.1088/2051-672X/aa51f8).

@@ -374,7 +374,7 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
 
     References
     ----------
-    B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10626-9.
+    B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037.
     """
     t_start = time.perf_counter()
     _check_psd(psd)

@@ -2,7 +2,7 @@
 
 :func:`bem_reference` is an *independent* check of Persson's contact theory and of the
 Lorenz–Persson flow theories (B. Lorenz & B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010),
-doi:10.1140/epje/i2010-10626-9). For each random-phase realization of a power spectrum it
+arXiv:1004.1037). For each random-phase realization of a power spectrum it
 
 1. synthesizes a periodic n×n height map whose periodogram equals C(q) at every lattice point
    (Persson convention, h_rms² = 2π ∫ q C(q) dq; random phases nested across grids, so n and

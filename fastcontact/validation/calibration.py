@@ -5,7 +5,7 @@ The shipped theory has four constants that no first-principles argument fixes:
 - γ, the Yang–Persson factor of ū(ζ) and u1(ζ) (C. Yang & B.N.J. Persson, J. Phys.: Condens.
   Matter 20, 215214 (2008), doi:10.1088/0953-8984/20/21/215214), default 1 (paper's A4);
 - α_cj and a_perc of the critical-junction theory (Lorenz & Persson 2010,
-  doi:10.1140/epje/i2010-10626-9, eqs. 31–32), defaults 1 and 0.5;
+  arXiv:1004.1037, eqs. 31–32), defaults 1 and 0.5;
 - the percolation threshold A_c of the generalized Bruggeman medium
   (:mod:`fastcontact.validation.emt`; Kirkpatrick, doi:10.1103/RevModPhys.45.574), default 1/2.
 

@@ -3,13 +3,13 @@
 Squeeze-out time propagation
 ----------------------------
 For a cylindrical block of radius R pressed with p0, eqs. (18)+(19) of Lorenz & Persson (2010,
-doi:10.1140/epje/i2010-10626-9) give dū/dt = -(8 σ_eff(p_c)/R²)(p0 - p_c) with p_c = p_c(ū)
+arXiv:1004.1037) give dū/dt = -(8 σ_eff(p_c)/R²)(p0 - p_c) with p_c = p_c(ū)
 the contact pressure. The equation is autonomous, so the time is a quadrature; with p_c as the
 variable (ū(p_c) is monotone),
 
     t(p_a → p_b) = (R²/8) ∫_{ln p_a}^{ln p_b} |dū/d ln p| / (σ_eff(p) (p0 - p)) d ln p,   (T1)
 
-and t* ends at p_b = p_c(1.01 ū∞), ū∞ = ū(p0) (SPEC §4 definition). Each model — the reference
+and t* ends at p_b = p_c(1.01 ū∞), ū∞ = ū(p0) (the definition of t* in Sec. 3 of Lorenz & Persson 2010). Each model — the reference
 and every theory — enters (T1) with *its own* ū(p), dū/d ln p and σ_eff(p); the contact stage
 starts at the reference's smallest pressure p_a (the time spent before it, at σ ∝ ū³ large, is
 negligible: 96–100 % of t* is in the contact stage). The ratio t*_theory/t*_reference is
@@ -32,7 +32,7 @@ DEFAULT_VARIANTS = (
     ("critical_junction", "critical_junction", {}),
     ("emt", "emt", {}),
 )
-#: squeeze-out ends at ū = T_STAR_FACTOR · ū∞ (SPEC §4)
+#: squeeze-out ends at ū = T_STAR_FACTOR · ū∞ (Lorenz & Persson 2010, Sec. 3)
 T_STAR_FACTOR = 1.01
 _N_T = 400
 

@@ -11,7 +11,7 @@ doi:10.1103/RevModPhys.45.574, eq. 5.8),
 has the conducting-phase threshold 2/z, i.e. the insulating (contact) phase blocks the flow
 at the area fraction A_c = 1 - 2/z. With k ≡ z/2 - 1 = A_c/(1 - A_c), the contact phase
 (σ = 0, weight A1 = A(ζ1)/A0) and the open phases of P(u) (weights W_j, σ_j = u1(ζ_j)³/12η,
-SPEC §3) give
+Lorenz & Persson 2010, arXiv:0911.3019) give
 
     Σ_j W_j (σ_j - σ_m) / (σ_j + k σ_m) - A1 / k = 0,                                (E2)
 
