@@ -60,7 +60,9 @@ def _times(pr, st, vinf, vs, Ts, tg, tau, h, i, out):
             out.U[k, i] = vinf * h
         else:
             z = z_of_t(pr, st, vinf, Ts + tk)
-            out.U[k, i] = vinf * (1.0 + math.exp(z)) * h
+            # ū(t) <= ū(0): the inverse interpolation can land an ulp above the start for
+            # t → 0; keep the ODE's monotonicity exactly (a round-off bound, not a clamp of data)
+            out.U[k, i] = min(vinf * (1.0 + math.exp(z)), vs) * h
 
 
 @njit(cache=True)
@@ -141,4 +143,4 @@ def history_kernel(pr, x0, vs_in, tau, h, t, u):
         elif tk == math.inf:
             u[k] = vinf * h
         else:
-            u[k] = vinf * (1.0 + math.exp(z_of_t(pr, st, vinf, Ts + tk))) * h
+            u[k] = min(vinf * (1.0 + math.exp(z_of_t(pr, st, vinf, Ts + tk))), vs) * h
