@@ -225,13 +225,36 @@ def test_recorded_interpolation_error_meets_the_targets(tables):
         assert err[f"sigma_{th}"] <= 1e-4
 
 
+#: a fresh build equals the shipped tables to RTOL_VALUES in every tabulated value; the
+#: derivative columns (d ln ·/d ln p, d² ln ·/d ln p²) are differentiated next to the
+#: percolation kink, where the last digits of the arithmetic (they differ between CPUs:
+#: AVX2 vs AVX-512 code, libm) are amplified to up to 4e-5 in one second-derivative node per
+#: table (measured on two EPYC machines); they only set the Hermite slopes: a relative change
+#: r of d² ln σ/d ln p² moves the interpolated ln σ by r |d²| Δ²/8 ~ 1e-8 at most, far inside
+#: the recorded interpolation error of σ (<= 1e-4, checked below)
+RTOL_VALUES = 1e-10
+RTOL_DERIVATIVES = 1e-4
+
+
+def assert_same_build(fresh, shipped, name):
+    assert fresh.equals(shipped, rtol=1.0), f"tables/{name}.parquet: structure or options differ"
+    for k, a in shipped.data.items():
+        b = fresh.data[k]
+        tol = RTOL_DERIVATIVES if k.startswith(("dln", "d2ln")) else RTOL_VALUES
+        if a.dtype.kind == "f":
+            np.testing.assert_allclose(b, a, rtol=tol, atol=0.0, equal_nan=True, err_msg=(
+                f"tables/{name}.parquet column {k} is stale: run `fastcontact tables defaults`"))
+        else:
+            np.testing.assert_array_equal(b, a, err_msg=f"tables/{name}.parquet column {k}")
+
+
 @pytest.mark.parametrize("name", sorted(DEFAULT_SURFACES))
 def test_shipped_default_tables_match_a_fresh_build(name):
     shipped = load_default_tables(name)
     assert shipped.surface.fingerprint() == default_surface(name).fingerprint()
     fresh = precompute(default_surface(name), theories=shipped.theories, gamma=shipped.options["gamma"],
                        a_perc=shipped.options["a_perc"], alpha_cj=shipped.options["alpha_cj"])
-    assert fresh.equals(shipped, rtol=1e-10), f"tables/{name}.parquet is stale: run `fastcontact tables defaults`"
+    assert_same_build(fresh, shipped, name)
     for k, v in shipped.info["interpolation_error"].items():
         assert v <= (1e-6 if k in ("u", "p_of_u") else 1e-4), (k, v)
 
@@ -273,7 +296,7 @@ def test_cli_rebuilds_default_tables_into_a_folder(tmp_path):
     assert main(["tables", "defaults", "-o", str(tmp_path)]) == 0
     for name in DEFAULT_SURFACES:
         rebuilt = Tables.from_parquet(tmp_path / f"{name}.parquet")
-        assert rebuilt.equals(load_default_tables(name), rtol=1e-10)
+        assert_same_build(rebuilt, load_default_tables(name), name)
 
 
 # --------------------------------------------------------------------------- integrity (issue 15.5)
