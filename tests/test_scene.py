@@ -185,7 +185,8 @@ def test_squeeze_results_match_engine(tmp_path):
     res = run_scene(load_scene(sc), tmp_path / "o")["results"]
     T = Tables.from_parquet(default_table_path("asphalt_024mm"))
     ref = squeeze_out(T, p0=np.array([1e5, 3e5]), E_star=effective_modulus(10e6, 0.5), R=0.01,
-                      eta=1e-3, ratios=(1.1, 1.01), du=(1e-6,), times=(1e-3,), method="quad")
+                      eta=1e-3, theory="average", ratios=(1.1, 1.01), du=(1e-6,),
+                      times=(1e-3,), method="quad")
     for c in ("u_inf", "t_star", "t_ratio_1.1", "t_du_1e-06", "u_at_0.001"):
         assert np.allclose(res[c].to_numpy(float), ref[c].to_numpy(float), rtol=1e-12), c
     assert set(squeeze_columns((1.1,), (1e-6,), (1e-3,))) >= {"t_ratio_1.1", "t_du_1e-06", "u_at_0.001"}
@@ -206,7 +207,8 @@ def test_tire_footprint_paper_numbers():
     from fastcontact.tire import tire_footprint
     T = Tables.from_parquet(default_table_path("asphalt_024mm"))
     df = tire_footprint(T, p0=0.2e6, E_star=effective_modulus(10e6, 0.5), R=0.02,
-                        eta=np.array([1e-3, 1.0]), footprint_length=0.1, speed=30.0)
+                        eta=np.array([1e-3, 1.0]), footprint_length=0.1, speed=30.0,
+                        theory="average")
     assert np.allclose(df.t_footprint, 0.1 / 30)
     # paper Sec. 5: "for the smoother road surface 2 it takes ~3e-5 s to reach Δu = 1 µm"
     assert 1e-5 < df.t_du.iloc[0] < 1e-4

@@ -80,11 +80,13 @@ def test_du_and_user_start_vs_reference(T):
     ref = SqueezeReference(T.surface, E, "average", pi0 * E)
     tau = tau0(ETA, R, T.h_rms, pi0 * E)
     du = 1e-7  # 0.01 h_rms
-    df = squeeze_out(T, p0=pi0 * E, E_star=E, R=R, eta=ETA, du=(du,), ratios=())
+    df = squeeze_out(T, p0=pi0 * E, E_star=E, R=R, eta=ETA, du=(du,), ratios=(),
+                     theory="average")
     assert _rel(df[column_name("t_du", du)].iloc[0] / tau, ref.t_du(du / T.h_rms)) < 1e-6
     assert "t_star" in df  # t* always computed even if 1.01 is not in ratios
     for vs in (5.0, 1e4):  # inside the table, and far beyond its top (analytic tail)
-        df = squeeze_out(T, p0=pi0 * E, E_star=E, R=R, eta=ETA, u_start=vs * T.h_rms)
+        df = squeeze_out(T, p0=pi0 * E, E_star=E, R=R, eta=ETA, u_start=vs * T.h_rms,
+                         theory="average")
         assert _rel(df["t_star"].iloc[0] / tau, ref.t_ratio(1.01, v_start=vs)) < 1e-6
 
 
@@ -144,7 +146,8 @@ def test_flat_surface_limit_far_from_equilibrium(T):
     h = T.h_rms
     ua = 1e4 * h
     times = [flat_stefan_time(ua, ub, pi0 * E, ETA, R) for ub in (1e3 * h, 300 * h, 100 * h)]
-    df = squeeze_out(T, p0=pi0 * E, E_star=E, R=R, eta=ETA, u_start=ua, times=times)
+    df = squeeze_out(T, p0=pi0 * E, E_star=E, R=R, eta=ETA, u_start=ua, times=times,
+                     theory="average")
     got = np.array([df[column_name("u_at", t)].iloc[0] for t in times])
     np.testing.assert_allclose(got, [1e3 * h, 300 * h, 100 * h], rtol=1e-6)
     hist = squeeze_history(T, pi0 * E, E, R, ETA, "average", t=np.array(times), u_start=ua)
@@ -238,7 +241,7 @@ def test_tstar_decreasing_in_p0_in_asymptotic_regime(T):
         t = squeeze_out(T, p0=pis * E, E_star=E, R=R, eta=ETA, theory=theory)["t_star"].to_numpy()
         assert np.all(np.diff(t) < 0), theory
     pis = np.geomspace(1e-2, 0.3, 10)
-    t = squeeze_out(T, p0=pis * E, E_star=E, R=R, eta=ETA)["t_star"].to_numpy()
+    t = squeeze_out(T, p0=pis * E, E_star=E, R=R, eta=ETA, theory="average")["t_star"].to_numpy()
     assert np.all(np.diff(t) > 0)
 
 

@@ -26,7 +26,7 @@ import matplotlib
 import matplotlib.ticker
 import numpy as np
 
-from .._core.vocab import column_name
+from .._core.vocab import DEFAULT_THEORY, column_name
 from ..contact.elasticity import effective_modulus
 from ..squeeze import squeeze_history, squeeze_out
 from ..squeeze.reduced import flat_separation
@@ -45,7 +45,7 @@ COLORS = ("tab:red", "tab:blue", "tab:green", "tab:purple", "tab:orange", "tab:b
           "tab:pink", "tab:olive")
 
 
-def tire_curve(tables, *, p0, E_star, R, eta, theory="average", u_start=PAPER["u_start"],
+def tire_curve(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=PAPER["u_start"],
                ratios=PAPER["ratios"], du=PAPER["du_complete"], label="", n=400):
     """ū(t), Δu(t), flat-surface ū(t), ū∞ and the ratio/Δu times of one tread-block case.
 

@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from .._core.validate import align_inputs, check_positive
+from .._core.vocab import DEFAULT_THEORY
 from . import _panels, _sigma
 from ._inputs import (alpha_scale, check_tables, check_theory_for, common_inputs, forbid,
                       hertz_contact, profile_kind, require)
@@ -202,7 +203,7 @@ def _leak_array(sc, theory, p0x, x, com, alpha_cj, o):
 
 
 # =========================================================================== public
-def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory="critical_junction",
+def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_THEORY,
               alpha_cj=1.0, p_b=0.0, profile="uniform", R=None, f_N=None, x=None, a_perc=None,
               solver=None, alpha_pv=0.0):
     """Leak rate of a static seal, Q = L_y q [m³/s], for many cases at once.
@@ -227,7 +228,7 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory="critical
         Effective modulus [Pa].
     eta : float or array_like
         Fluid viscosity [Pa·s].
-    theory : {"critical_junction", "emt", "average"}, default "critical_junction"
+    theory : {"critical_junction", "emt", "average"}, default DEFAULT_THEORY ("critical_junction")
         Flow-conductivity theory (must be in the tables).
     alpha_cj : float or array_like, default 1.0
         Critical-junction factor [-] (σ ∝ α_cj³; rescales the table's α exactly).

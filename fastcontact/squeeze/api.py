@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 
 from .._core.validate import align_inputs, as_float_array, check_positive
-from .._core.vocab import REFERENCES, column_name
+from .._core.vocab import DEFAULT_THEORY, REFERENCES, column_name
 from ..tables import Tables
 from . import _kernels as qk
 from ._fastpath import fast_kernel, history_kernel, quad_kernel
@@ -164,7 +164,7 @@ def attrs(model, cols, method):
     }
 
 
-def squeeze_out(tables, *, p0, E_star, R, eta, theory="average", u_start=None,
+def squeeze_out(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=None,
                 ratios=(1.1, 1.01, 1.001), du=(), times=(), method="fast",
                 quad_order=QUAD_ORDER, quad_width=QUAD_WIDTH, sigma_trap=None, **extensions):
     """Squeeze-out of a flat cylindrical block against the tables' rough surface.
@@ -186,7 +186,7 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory="average", u_start=None,
         Block radius [m], > 0.
     eta : array_like
         Fluid viscosity η [Pa·s], > 0.
-    theory : str, default "average"
+    theory : str, default DEFAULT_THEORY ("critical_junction")
         Flow-conductivity theory ("average", "critical_junction", "emt").
     u_start : array_like or None, default None
         Initial separation [m] (+inf allowed). None: where p_cont = 1e-3 p0. A start at or
@@ -271,7 +271,7 @@ def frame(model, cs, out, ratios, du, times, order, names, method):
     return df
 
 
-def squeeze_history(tables, p0, E_star, R, eta, theory="average", t=None, u_start=None, *,
+def squeeze_history(tables, p0, E_star, R, eta, theory=DEFAULT_THEORY, t=None, u_start=None, *,
                     quad_order=16, quad_width=0.5, sigma_trap=None):
     """ū(t), p_cont(t)/p0 and the mean fluid pressure of ONE case on a time array.
 

@@ -15,6 +15,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from .._core.vocab import DEFAULT_THEORY
 from ..tables import Tables
 from . import _kernels as qk
 from . import primitive as prim
@@ -169,14 +170,14 @@ def _fingerprint(tables):
             int(tables.info.get("nodes", -1)), repr(sorted(tables.options.items())))
 
 
-def squeeze_model(tables, theory="average", sigma_trap=None) -> SqueezeModel:
+def squeeze_model(tables, theory=DEFAULT_THEORY, sigma_trap=None) -> SqueezeModel:
     """The cached :class:`SqueezeModel` of (tables, theory), built on first use.
 
     Parameters
     ----------
     tables : Tables
         Precomputed surface tables holding ``theory``.
-    theory : str
+    theory : str, default DEFAULT_THEORY ("critical_junction")
         Flow-conductivity theory.
     sigma_trap : float or None
         Reduced conductivity floor of the trap criterion [-] (default: the tables'

@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 
 from .._core.validate import as_float_array, check_positive
-from .._core.vocab import column_name
+from .._core.vocab import DEFAULT_THEORY, column_name
 from . import _kernels as qk
 from .api import _check_method, attrs, run_cases, squeeze_history, squeeze_out, status_column
 from .model import squeeze_model
@@ -164,7 +164,7 @@ def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
 
 
 def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1000.0,
-                   theory="average", pressure_profile="uniform", pressure_model="mean",
+                   theory=DEFAULT_THEORY, pressure_profile="uniform", pressure_model="mean",
                    u_start=PAPER_TIRE["u_start"], du_complete=1e-6, ratios=(1.1, 1.01, 1.001),
                    columns=None, method=None):
     """Squeeze-out of a tread block during its passage through the footprint (Sec. 5).
@@ -190,7 +190,7 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
         Rolling speed v [m/s]; the block spends t_footprint = L_f/v in the footprint.
     rho : array_like, default 1000
         Fluid density [kg/m³] (inertia estimate only).
-    theory : str, default "average"
+    theory : str, default DEFAULT_THEORY ("critical_junction")
         Flow-conductivity theory.
     pressure_profile : {"uniform", "parabolic"} or sequence, default "uniform"
         Relative pressure along the footprint (module docstring).
@@ -260,7 +260,7 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
     return df
 
 
-def tire_history(tables, *, p0, E_star, R, eta, t, theory="average",
+def tire_history(tables, *, p0, E_star, R, eta, t, theory=DEFAULT_THEORY,
                  u_start=PAPER_TIRE["u_start"]):
     """ū(t) [m] of one tread block at constant nominal pressure ``p0`` (p_eval) over times t.
 

@@ -30,7 +30,7 @@ import pandas as pd
 from numba import njit, prange
 
 from .._core.validate import check_positive
-from .._core.vocab import column_name
+from .._core.vocab import DEFAULT_THEORY, column_name
 from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
 from .api import register_extension, squeeze_out
 
@@ -268,7 +268,7 @@ def _scalars(tables, theory, sigma_trap):
     return sc
 
 
-def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory="average",
+def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_THEORY,
                       u_start=None, ratios=(1.1, 1.01, 1.001), du=(), quad_order=10,
                       quad_width=1.0, sigma_trap=None):
     """Squeeze-out times of a flat block with a Barus fluid η = η0 exp(α_pv p_f) [s].
@@ -282,7 +282,7 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory="average",
         η0 at the outlet (ambient) pressure [Pa·s]; broadcast against each other.
     alpha_pv : array_like
         Pressure–viscosity coefficient α [1/Pa], >= 0 (0: the paper's constant viscosity).
-    theory : str
+    theory : str, default DEFAULT_THEORY ("critical_junction")
         Flow theory of σ_eff ("average", "critical_junction", "emt").
     u_start : array_like or None
         Initial separation [m]; None: where p_cont = 1e-3 p0 (as :func:`squeeze_out`).

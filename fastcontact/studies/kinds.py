@@ -13,7 +13,7 @@ from typing import Callable
 
 import numpy as np
 
-from .._core.vocab import column_name
+from .._core.vocab import DEFAULT_THEORY, column_name
 from ..seal import seal_leak
 from ..squeeze import columns as squeeze_engine_columns
 from ..squeeze import squeeze_out
@@ -226,18 +226,18 @@ def _seal_evaluate(tables, rows, theory, fixed, columns, scale=1.0):
 _RATIOS = (1.1, 1.01, 1.001)
 KINDS = {
     "squeeze": StudyKind(
-        "squeeze", {"theory": "average", "ratios": _RATIOS, "du": (1e-6,), "times": ()},
+        "squeeze", {"theory": DEFAULT_THEORY, "ratios": _RATIOS, "du": (1e-6,), "times": ()},
         ("u_of_t", "t_star"), _squeeze_infer,
         lambda fixed: squeeze_columns(fixed.get("ratios", _RATIOS), fixed.get("du", (1e-6,)),
                                       fixed.get("times", ())),
         _squeeze_evaluate),
     "tire": StudyKind(
-        "tire", {"theory": "average", "ratios": _RATIOS, "pressure_profile": "uniform",
+        "tire", {"theory": DEFAULT_THEORY, "ratios": _RATIOS, "pressure_profile": "uniform",
                  "pressure_model": "mean", "du_complete": 1e-6, "u_start": 1e-2, "rho": 1000.0},
         ("u_of_t", "du_of_t"), _tire_infer,
         lambda fixed: list(tire_columns(fixed.get("ratios", _RATIOS))), _tire_evaluate),
     "seal": StudyKind(
-        "seal", {"theory": "critical_junction", "p_b": 0.0, "profile": "uniform",
+        "seal", {"theory": DEFAULT_THEORY, "p_b": 0.0, "profile": "uniform",
                  "alpha_cj": 1.0},
         ("leak_rate", "profiles"), _seal_infer, _seal_columns, _seal_evaluate),
 }

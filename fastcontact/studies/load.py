@@ -376,7 +376,8 @@ def load_scene(scene, *, for_sweep=False, base_dir=None, max_cases=None) -> Scen
 
     Notes
     -----
-    Sections: ``[study]`` (``kind`` = squeeze | tire | seal, ``theory``, ``p0`` and the
+    Sections: ``[study]`` (``kind`` = squeeze | tire | seal, ``theory`` (default
+    ``"critical_junction"``, :data:`fastcontact._core.vocab.DEFAULT_THEORY`), ``p0`` and the
     kind's parameters), ``[surfaces.<name>]`` (``table`` = a table file or embedded default,
     optionally with the surface's self-affine parameters to check it; ``psd`` = file +
     ``convention``; or ``h_rms``, ``hurst``, ``q0``, ``q1`` [, ``q_roll``]), ``[material]``

@@ -5,7 +5,7 @@ import dataclasses
 import difflib
 
 from .._core.units import SI_UNITS, parse_quantity
-from .._core.vocab import CONVENTIONS
+from .._core.vocab import CONVENTIONS, DEFAULT_THEORY
 
 __all__ = ["STUDY_KINDS", "Key", "SCHEMA", "SURFACE_KEYS", "TOP_KEYS", "AXIS_KEYS", "RANGE_KEYS",
            "SELF_AFFINE_KEYS", "MAX_CASES", "did_you_mean", "input_units", "parse_scalar",
@@ -54,7 +54,8 @@ _K = Key
 SCHEMA = {
     "study": {
         "kind": _K("choice", choices=STUDY_KINDS, doc="study kind"),
-        "theory": _K("theory", axis=True, doc="flow-conductivity theory"),
+        "theory": _K("theory", axis=True,
+                     doc=f"flow-conductivity theory (default {DEFAULT_THEORY!r})"),
         "p0": _K("num", "pressure", axis=True, lo=0, lo_open=True, doc="nominal pressure"),
         "u_start": _K("num", "length", axis=True, studies=("squeeze", "tire"), lo=0,
                       lo_open=True, doc="initial mean separation"),
