@@ -104,6 +104,11 @@ def _add_tables_parser(sub):
                     help="effective-medium percolation threshold A/A0 (0.5 = 2-D Bruggeman)")
     tb.add_argument("--calibration", help="calibration TOML file (fastcontact bem calibrate): "
                                           "sets gamma, a_perc, alpha_cj, emt_threshold")
+    tb.add_argument("--anisotropy", type=float, default=1.0,
+                    help="Peklenik number gamma_T >= 1 (roughness stretched along x; needs emt): "
+                         "also tabulate sigma_xx, sigma_yy")
+    tb.add_argument("--anisotropy-form", choices=("self_consistent", "fixed"),
+                    default="self_consistent", help="depolarization form of the anisotropic medium")
     tb.add_argument("-o", "--output", required=True, help="output .parquet file")
     ti = tsub.add_parser("info", help="show a table file's metadata")
     ti.add_argument("file", help="tables .parquet file")
@@ -281,7 +286,8 @@ def _cmd_tables_build(a, out, err):
             from .validation.calibration import Calibration
             cal = Calibration.from_toml(_existing_file(a.calibration, "--calibration"))
         T = precompute(psd, theories=theories, gamma=a.gamma, a_perc=a.a_perc,
-                       alpha_cj=a.alpha_cj, emt_threshold=a.emt_threshold, calibration=cal)
+                       alpha_cj=a.alpha_cj, emt_threshold=a.emt_threshold, calibration=cal,
+                       anisotropy=a.anisotropy, anisotropy_form=a.anisotropy_form)
         prog.advance()
     T.to_parquet(a.output)
     print(f"wrote {a.output} ({T.info['nodes']} nodes, {T.info['build_seconds']:.2f} s)", file=out)
@@ -320,6 +326,11 @@ def tables_info_text(path):
     if perc:
         lines.append("percolation pressure p/E*: " + ", ".join(
             f"{k} = {'never' if not math.isfinite(v) else format(v, '.6g')}" for k, v in perc.items()))
+    d = info.get("directional")
+    if d:                                              # issue 14: anisotropic tables
+        lines.append(f"anisotropy: gamma_T = {d.get('anisotropy')}, form {d.get('form')}; "
+                     f"percolation p/E*: {_fmt_dict(d.get('percolation_p_over_E', {}))}; "
+                     f"interpolation errors: {_fmt_dict(d.get('interpolation_error', {}))}")
     if "asymptote_u0_over_h" in info:
         lines.append(f"asymptote (eq. 3): u0/h_rms = {info['asymptote_u0_over_h']:.6g}, "
                      f"beta = {info['asymptote_beta']:.6g}")

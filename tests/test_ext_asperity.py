@@ -90,3 +90,39 @@ def test_bad_levels(psd):
         asperity_levels(psd, p0=2e5, E_star=E_STAR, R=R, eta=ETA, zetas=[2.0, 4.0])
     with pytest.raises(ValueError, match="level_ratio"):
         asperity_levels(psd, p0=2e5, E_star=E_STAR, R=R, eta=ETA, level_ratio=1.0)
+
+
+def test_threshold_from_the_tables(psd):
+    """The trap criterion uses the tables' percolation area (a calibrated emt_threshold = 0.3
+    here), not a hard-coded 0.5; the levels inherit the base tables' options."""
+    kw = dict(p0=2e5, E_star=E_STAR, R=R, eta=ETA, theory="emt", zetas=[1.0, 8.0, 64.0])
+    cal = fc.precompute(psd, theories=("emt",), points_per_decade=4, emt_threshold=0.3)
+    df = asperity_levels(tables=cal, **kw)
+    assert df.attrs["level_options"]["emt_threshold"] == 0.3
+    np.testing.assert_array_equal(df["area_threshold"], 0.3)
+    a = df["area_restricted"].to_numpy()
+    assert a[1] >= 0.3 > a[0] and a[1] < 0.5          # trapped at ζ = 8 only through 0.3
+    assert list(df["trapped"]) == [False, True, True] and df.attrs["zeta_trap"] == 8.0
+    default = asperity_levels(psd, tables_kwargs=dict(points_per_decade=4), **kw)
+    np.testing.assert_array_equal(default["area_threshold"], 0.5)
+    assert list(default["trapped"]) == [False, False, True]
+    # level ζ = 1 runs on the given tables themselves
+    base = squeeze_out(cal, p0=2e5, E_star=E_STAR, R=R, eta=ETA, theory="emt", ratios=(1.1,))
+    assert df["t_star"][0] == base["t_star"][0]
+
+
+def test_summary_matches_levels(psd):
+    from fastcontact.squeeze.asperity import asperity_summary
+    T = fc.precompute(psd, theories=("average",))
+    p0 = np.array([1e5, 2e5])
+    s = asperity_summary(T, p0=p0, E_star=E_STAR, R=R, eta=ETA, theory="average",
+                         level_ratio=4.0, zeta_max=64.0)
+    for i, p in enumerate(p0):
+        lv = asperity_levels(tables=T, p0=p, E_star=E_STAR, R=R, eta=ETA, theory="average",
+                             level_ratio=4.0, zeta_max=64.0)
+        assert s["n_levels"][i] == len(lv) and s["zeta_top"][i] == lv["zeta"].iloc[-1]
+        np.testing.assert_allclose([s["t_sequential"][i], s["t_parallel"][i],
+                                    s["t_star_base"][i], s["t_star_top"][i]],
+                                   [lv["t_sequential"].iloc[-1], lv["t_parallel"].iloc[-1],
+                                    lv["t_star"].iloc[0], lv["t_star"].iloc[-1]], rtol=1e-12)
+        assert s["zeta_trap"][i] == lv.attrs["zeta_trap"] == math.inf

@@ -135,9 +135,7 @@ def test_squeeze_options_bad(tab, param, value):
     refused_by_name(param, lambda: squeeze_out(tab, **kw))
 
 
-@pytest.mark.parametrize("method", ["fast", pytest.param("quad", marks=pytest.mark.xfail(
-    reason="known open bug (issue 15): method='quad' returns t_du = NaN with status 'ok' when "
-           "u_inf + du is not representable (du = 1e-20 m)", strict=False))])
+@pytest.mark.parametrize("method", ["fast", "quad"])
 def test_du_below_resolution(tab, method):
     """du = 1e-20 m (below double resolution of ū∞ + du): refused naming ``du``, or a result
     whose every non-finite value is flagged (never a traceback, never an unflagged NaN)."""

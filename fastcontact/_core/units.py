@@ -18,12 +18,13 @@ DIMENSIONS = {
     "pressure": (1, -1, -2), "length": (0, 1, 0), "wavevector": (0, -1, 0),
     "viscosity": (1, -1, -1), "density": (1, -3, 0), "time": (0, 0, 1),
     "velocity": (0, 1, -1), "force_per_length": (1, 0, -2), "dimensionless": (0, 0, 0),
+    "inverse_pressure": (-1, 1, 2),
 }
 #: the SI unit string of each dimension (as written in result metadata)
 SI_UNITS = {
     "pressure": "Pa", "length": "m", "wavevector": "1/m", "viscosity": "Pa s",
     "density": "kg/m^3", "time": "s", "velocity": "m/s", "force_per_length": "N/m",
-    "dimensionless": "1",
+    "dimensionless": "1", "inverse_pressure": "1/Pa",
 }
 #: units accepted for each dimension (for messages)
 UNIT_EXAMPLES = {
@@ -31,10 +32,12 @@ UNIT_EXAMPLES = {
     "wavevector": "1/m, 1/mm, 1/um", "viscosity": "Pa s, mPa s, cP",
     "density": "kg/m^3, g/cm^3", "time": "s, ms, us, min", "velocity": "m/s, km/h",
     "force_per_length": "N/m, N/mm", "dimensionless": "no unit",
+    "inverse_pressure": "1/Pa, 1/MPa, 1/GPa",
 }
 _EXAMPLE = {"pressure": "0.2 MPa", "length": "2 cm", "wavevector": "1e5 1/m",
             "viscosity": "1 mPa s", "density": "1000 kg/m^3", "time": "3 ms",
-            "velocity": "30 m/s", "force_per_length": "1 N/mm", "dimensionless": "0.5"}
+            "velocity": "30 m/s", "force_per_length": "1 N/mm", "dimensionless": "0.5",
+            "inverse_pressure": "20 1/GPa"}
 
 _D = Decimal
 _BASE_UNITS = {

@@ -34,6 +34,8 @@ doi:10.1115/1.3254641.
 from __future__ import annotations
 
 import math
+import threading
+import weakref
 
 import numpy as np
 from numba import njit, prange
@@ -45,7 +47,7 @@ from ..contact import area_fraction, percolation_pressure
 from ..contact._kernels import PANEL, psd_kernel, u1_at_area
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.special import k_table
-from .conductivity import check_theory, conductivity
+from .conductivity import check_emt_threshold, check_theory, conductivity
 
 __all__ = [
     "FORMS",
@@ -54,7 +56,11 @@ __all__ = [
     "directional_sigma_bar",
     "precompute_directional",
     "directional_tables",
+    "directional_columns",
+    "tables_for_direction",
+    "table_anisotropy",
     "sigma_directional",
+    "DIRECTIONAL_STEMS",
 ]
 
 FORMS = ("self_consistent", "fixed")
@@ -106,17 +112,24 @@ def _solve_dir(W, sig, A1, lam):
 
 
 @njit(cache=True)
-def _solve_self_consistent(W, sig, A1, gam):
-    """(σ̄_xx, σ̄_yy) with λ = γ √(σ_yy/σ_xx) found by bisection/secant in ln λ."""
-    if A1 >= 0.5:
+def _solve_self_consistent(W, sig, A1, gam, kk=1.0):
+    """(σ̄_xx, σ̄_yy) with Λ = γ √(σ_yy/σ_xx) found by bisection in ln Λ.
+
+    The x equation has λ = kk Λ, the y equation λ = kk/Λ; kk = A_c/(1 - A_c) is the odds of
+    the tables' effective-medium threshold A_c (1 for the 2-D Bruggeman A_c = 1/2), so both
+    close together at A(ζ1)/A0 = A_c (Λ = 1 there) for every γ_T.
+    """
+    if A1 >= kk / (1.0 + kk):
         return 0.0, 0.0
-    lo = math.log(A1 / (1.0 - A1)) if A1 > 0.0 else -60.0
-    hi = -lo
+    lk = math.log(kk)
+    l0 = math.log(A1 / (1.0 - A1)) if A1 > 0.0 else -60.0 - abs(lk)
+    lo = l0 - lk
+    hi = -l0 + lk
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         lam = math.exp(mid)
-        sx = _solve_dir(W, sig, A1, lam)
-        sy = _solve_dir(W, sig, A1, 1.0 / lam)
+        sx = _solve_dir(W, sig, A1, kk * lam)
+        sy = _solve_dir(W, sig, A1, kk / lam)
         if sx <= 0.0:
             lo = mid
             continue
@@ -131,7 +144,7 @@ def _solve_self_consistent(W, sig, A1, gam):
         if hi - lo < 1e-14:
             return sx, sy
     lam = math.exp(0.5 * (lo + hi))
-    return _solve_dir(W, sig, A1, lam), _solve_dir(W, sig, A1, 1.0 / lam)
+    return _solve_dir(W, sig, A1, kk * lam), _solve_dir(W, sig, A1, kk / lam)
 
 
 # =========================================================================== P(u) nodes
@@ -178,23 +191,35 @@ def _nodes(psd, pbar, gamma, n_panels):
             np.ascontiguousarray(np.where(bad, 0.0, sig)), A1)
 
 
+def _odds(emt_threshold):
+    """kk = A_c/(1 - A_c) of an effective-medium threshold A_c (1 for A_c = 1/2)."""
+    a = float(check_emt_threshold(emt_threshold))
+    return 1.0 if a == 0.5 else a / (1.0 - a)
+
+
 def directional_sigma_bar(psd, pbar, anisotropy, *, form="self_consistent", gamma=1.0,
-                          n_panels=N_PANELS):
+                          n_panels=N_PANELS, emt_threshold=0.5):
     """(σ̄_xx, σ̄_yy) = 12ησ/h_rms³ [-] of the anisotropic Bruggeman medium at p̄ = p/E*.
 
     Always runs the anisotropic solver (also at γ_T = 1; used to test continuity).
+    ``emt_threshold`` A_c [-] is the isotropic medium's percolation threshold (0.5: 2-D
+    Bruggeman; a calibrated value as in :func:`~fastcontact.flow.conductivity.conductivity`):
+    the depolarization odds (1 - n)/n become kk γ_T^{±1} ("fixed") or kk Λ^{±1}
+    ("self_consistent"), kk = A_c/(1 - A_c), so that γ_T = 1 is the generalized isotropic
+    medium and the self-consistent thresholds stay at A_c.
     """
     pbar = np.atleast_1d(np.asarray(pbar, dtype=np.float64)).ravel()
     sx = np.empty(pbar.size)
     sy = np.empty(pbar.size)
     W, sig, A1 = _nodes(psd, pbar, gamma, int(n_panels))
     g = float(anisotropy)
+    kk = _odds(emt_threshold)
     for i in range(pbar.size):
         if form == "self_consistent":
-            sx[i], sy[i] = _solve_self_consistent(W[i], sig[i], float(A1[i]), g)
+            sx[i], sy[i] = _solve_self_consistent(W[i], sig[i], float(A1[i]), g, kk)
         else:
-            sx[i] = _solve_dir(W[i], sig[i], float(A1[i]), g)
-            sy[i] = _solve_dir(W[i], sig[i], float(A1[i]), 1.0 / g)
+            sx[i] = _solve_dir(W[i], sig[i], float(A1[i]), kk * g)
+            sy[i] = _solve_dir(W[i], sig[i], float(A1[i]), kk / g)
     return sx, sy
 
 
@@ -223,7 +248,7 @@ def directional_threshold(a_perc, anisotropy, direction):
 
 def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, direction="x", *,
                       form="self_consistent", gamma=1.0, a_perc=0.5, alpha_cj=1.0,
-                      n_panels=N_PANELS):
+                      n_panels=N_PANELS, emt_threshold=0.5):
     """Directional interfacial conductivity σ_xx or σ_yy [m³/(Pa·s)] by direct quadrature.
 
     Parameters
@@ -245,8 +270,9 @@ def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, directi
         Flow along the long correlation length ("x", the grooves) or across it ("y").
     form : {"self_consistent", "fixed"}
         Depolarization factors in the anisotropic effective medium or in an isotropic host.
-    gamma, a_perc, alpha_cj :
-        As in :func:`~fastcontact.flow.conductivity.conductivity`.
+    gamma, a_perc, alpha_cj, emt_threshold :
+        As in :func:`~fastcontact.flow.conductivity.conductivity` (``a_perc``: the critical
+        junction's isotropic threshold; ``emt_threshold``: the effective medium's).
     n_panels : int
         Gauss–Legendre panels (order 10) of the P(u) quadrature in A (EMT).
 
@@ -258,17 +284,18 @@ def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, directi
     p = check_positive("p", p, "[Pa]")
     E_star = float(check_positive("E_star", E_star, "[Pa]"))
     eta = float(check_positive("eta", eta, "[Pa·s]"))
+    a_c = float(check_emt_threshold(emt_threshold))
     if g == 1.0 or theory == "average":
         return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_perc,
-                            alpha_cj=alpha_cj)
+                            alpha_cj=alpha_cj, emt_threshold=a_c)
     if theory == "critical_junction":
         a_dir = directional_threshold(float(a_perc), g, direction)
         return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_dir,
                             alpha_cj=alpha_cj)
     sx, sy = directional_sigma_bar(psd, np.ravel(p) / E_star, g, form=form, gamma=gamma,
-                                   n_panels=n_panels)
+                                   n_panels=n_panels, emt_threshold=a_c)
     sb = (sx if direction == "x" else sy).reshape(np.shape(p))
-    a_thr = 0.5 if form == "self_consistent" else directional_threshold(0.5, g, direction)
+    a_thr = a_c if form == "self_consistent" else directional_threshold(a_c, g, direction)
     perc = np.asarray(area_fraction(psd, p, E_star)) >= a_thr
     return sb * psd.h_rms ** 3 / (12.0 * eta), perc
 
@@ -342,7 +369,8 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
     Starts from the tables' p̄ nodes and bisects every interval whose spline misses the
     direct solver at its midpoint by more than ``tol`` (relative, where σ̄ > sigma_floor),
     up to ``max_rounds`` times; the final midpoint errors go to ``info``. The tables'
-    Yang–Persson γ is reused.
+    Yang–Persson γ and effective-medium threshold (``options["emt_threshold"]``, 0.5 when
+    absent; set by a calibration) are reused: the directional thresholds are derived from it.
 
     Returns
     -------
@@ -353,21 +381,32 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
     t0 = time.perf_counter()
     g = _check("emt", anisotropy, "x", form)
     psd = tables.surface
+    if tables.options.get("emt_almqvist", False):
+        raise ValueError("tables = ... are invalid for the anisotropic medium: they were built "
+                         "with emt_almqvist = True (the broadened P(u) is not implemented for "
+                         "σ_xx, σ_yy); rebuild them with emt_almqvist = False")
     gamma = float(tables.options.get("gamma", 1.0))
+    a_c = float(tables.options.get("emt_threshold", 0.5))
     lnp = np.log(np.asarray(tables.data["p_over_E"], dtype=np.float64))
-    thr = {"x": 0.5, "y": 0.5} if form == "self_consistent" else \
-        {d: directional_threshold(0.5, g, d) for d in ("x", "y")}
+    thr = {"x": a_c, "y": a_c} if form == "self_consistent" else \
+        {d: directional_threshold(a_c, g, d) for d in ("x", "y")}
     lnp_perc = {d: math.log(float(percolation_pressure(psd, 1.0, thr[d]))) for d in thr}
     sx, sy = directional_sigma_bar(psd, np.exp(lnp), g, form=form, gamma=gamma,
-                                   n_panels=n_panels)
+                                   n_panels=n_panels, emt_threshold=a_c)
     rounds = 0
+    cache = {}                  # exact midpoint values: an unsplit interval keeps its midpoint
     while True:
         rounds += 1
         tab = DirectionalTable(tables, g, "emt", form, lnp, _lnsig(sx, sy, lnp, lnp_perc),
                                lnp_perc, {})
         xm = 0.5 * (lnp[:-1] + lnp[1:])
-        mx, my = directional_sigma_bar(psd, np.exp(xm), g, form=form, gamma=gamma,
-                                       n_panels=n_panels)
+        new = np.array([x not in cache for x in xm.tolist()], dtype=bool)
+        if np.any(new):
+            nx, ny = directional_sigma_bar(psd, np.exp(xm[new]), g, form=form, gamma=gamma,
+                                           n_panels=n_panels, emt_threshold=a_c)
+            cache.update(zip(xm[new].tolist(), zip(nx.tolist(), ny.tolist())))
+        mx = np.array([cache[x][0] for x in xm.tolist()])
+        my = np.array([cache[x][1] for x in xm.tolist()])
         bad = np.zeros(xm.size, dtype=bool)
         err = {}
         for d, m in (("x", mx), ("y", my)):
@@ -386,11 +425,137 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
                      "refinement_rounds": rounds,
                      "percolation_p_over_E": {d: math.exp(v) for d, v in lnp_perc.items()},
                      "anisotropy": g, "form": form, "n_panels": int(n_panels),
+                     "emt_threshold": a_c,
                      "build_seconds": time.perf_counter() - t0})
     return tab
 
 
-def directional_tables(tables, anisotropy, direction="x", *, form="self_consistent",
+#: the effective-medium columns that carry a direction; tables built with
+#: ``precompute(..., anisotropy=γ_T)`` hold each with the suffixes "_x" and "_y"
+DIRECTIONAL_STEMS = ("sigma_emt", "dlnsigma_emt", "d2lnsigma_emt", "phi_emt", "percolated_emt")
+DIRECTIONS = ("x", "y")
+
+
+def _columns_on_nodes(tables, d, direction):
+    """The "emt" columns in ``direction`` on the tables' own p̄ nodes, from the spline of the
+    :class:`DirectionalTable` ``d`` (σ̄, its first two ln-derivatives, φ_p, percolated)."""
+    lnp = np.log(np.asarray(tables.data["p_over_E"], dtype=np.float64))
+    spl, n_open = d._spl[direction]
+    last = d.lnp[n_open - 1]
+    sig = d.sigma_bar(np.exp(lnp), 1.0, direction)
+    inside = (lnp <= last) & (sig > 0)
+    return {"sigma_emt": np.ascontiguousarray(sig),
+            "dlnsigma_emt": np.ascontiguousarray(np.where(inside, spl(lnp, 1), 0.0)),
+            "d2lnsigma_emt": np.ascontiguousarray(np.where(inside, spl(lnp, 2), 0.0)),
+            "phi_emt": np.ascontiguousarray(sig / np.asarray(tables.data["u_over_h"]) ** 3),
+            "percolated_emt": lnp >= d.lnp_perc[direction]}
+
+
+def directional_columns(tables, directional):
+    """The columns ``<stem>_x``, ``<stem>_y`` (:data:`DIRECTIONAL_STEMS`) that
+    :func:`~fastcontact.tables.precompute` stores for ``anisotropy=γ_T``."""
+    out = {}
+    for direction in DIRECTIONS:
+        for k, v in _columns_on_nodes(tables, directional, direction).items():
+            out[f"{k}_{direction}"] = v
+    return out
+
+
+def table_anisotropy(tables):
+    """γ_T [-] the tables were built for (1.0: isotropic tables)."""
+    return float(tables.options.get("anisotropy", 1.0))
+
+
+def _stored(tables):
+    """True if ``tables`` hold both directions (built with precompute(anisotropy=γ_T))."""
+    return "direction" not in tables.options and all(
+        f"{k}_{d}" in tables.data for k in DIRECTIONAL_STEMS for d in DIRECTIONS)
+
+
+def _check_direction(direction):
+    if direction not in DIRECTIONS:
+        raise ValueError(f"direction = {direction!r} is invalid: must be 'x' (along the long "
+                         f"correlation length), 'y' (across it) or None")
+    return direction
+
+
+def _drop_theories(tables, keep):
+    drop = [t for t in tables.theories if t not in keep]
+    return {k: v for k, v in tables.data.items()
+            if not any(k.endswith("_" + t) for t in drop) and k not in ("zeta_c", "u1c_over_h")
+            and not (k.endswith(("_x", "_y")) and k[:-2] in DIRECTIONAL_STEMS)}
+
+
+def _tables_with(tables, keep, data, perc_emt, options, extra_info):
+    from ..tables import Tables
+
+    info = dict(tables.info)
+    perc = {k: v for k, v in dict(info.get("percolation_p_over_E", {})).items() if k in keep}
+    perc["emt"] = perc_emt
+    info["percolation_p_over_E"] = perc
+    info.update(extra_info)
+    return Tables(tables.surface, keep, options, tables.grid, tables.zeta_grid, data, info)
+
+
+_VIEWS = weakref.WeakKeyDictionary()
+_VIEWS_LOCK = threading.Lock()
+
+
+def _stored_view(tables, direction):
+    """The one-direction :class:`Tables` of tables that store both directions (cached per
+    parent object, so the engines' per-Tables caches are reused across calls)."""
+    with _VIEWS_LOCK:
+        per = _VIEWS.get(tables)
+        if per is None:
+            per = {}
+            _VIEWS[tables] = per
+        if direction not in per:
+            keep = [t for t in tables.theories if t in ("average", "emt")]
+            data = _drop_theories(tables, keep)
+            for k in DIRECTIONAL_STEMS:
+                data[k] = tables.data[f"{k}_{direction}"]
+            d_info = tables.info.get("directional", {})
+            perc = float(d_info["percolation_p_over_E"][direction])
+            options = dict(tables.options, direction=direction)
+            per[direction] = _tables_with(tables, keep, data, perc, options, {})
+        return per[direction]
+
+
+def tables_for_direction(tables, direction, theory=None):
+    """The tables an engine reads for flow in ``direction`` (None: ``tables`` itself).
+
+    * isotropic tables (no ``options["anisotropy"]``, i.e. γ_T = 1): ``tables`` itself for
+      every theory and direction — for isotropic roughness σ_xx = σ_yy = σ exactly, so the
+      result is identical to ``direction=None`` (documented choice, not an error);
+    * tables built with ``precompute(..., anisotropy=γ_T)``: a one-direction view whose "emt"
+      columns are σ̄_xx or σ̄_yy ("average" kept: it carries no direction). ``theory =
+      "critical_junction"`` raises ValueError (not tabulated per direction: use
+      :func:`sigma_directional` with ``form="fixed"``).
+    """
+    if direction is None:
+        return tables
+    _check_direction(direction)
+    if table_anisotropy(tables) == 1.0 and "direction" not in tables.options:
+        return tables
+    if "direction" in tables.options:
+        if tables.options["direction"] != direction:
+            raise ValueError(f"direction = {direction!r} is invalid for these tables: they are "
+                             f"already the {tables.options['direction']!r} view of "
+                             f"γ_T = {table_anisotropy(tables):g}")
+        return tables
+    if theory is not None and theory not in ("emt", "average"):
+        raise ValueError(f"direction = {direction!r} is invalid with theory = {theory!r}: the "
+                         f"tables hold directional conductivities for 'emt' only ('average' "
+                         f"carries no direction); use theory = 'emt'")
+    if not _stored(tables):
+        raise ValueError(f"tables = {tables!r} are invalid for direction = {direction!r}: "
+                         f"options record anisotropy = {table_anisotropy(tables):g} but the "
+                         f"directional columns are missing (rebuild with precompute(..., "
+                         f"anisotropy=...))")
+    return _stored_view(tables, direction)
+
+
+def directional_tables(tables, anisotropy=None, direction="x", *, form=None,
                        directional=None, n_panels=N_PANELS):
     """A :class:`~fastcontact.tables.Tables` whose "emt" conductivity is σ_xx or σ_yy.
 
@@ -398,39 +563,52 @@ def directional_tables(tables, anisotropy, direction="x", *, form="self_consiste
     Barus engines) then runs the anisotropic case unchanged. The "emt" columns (σ̄ and its
     first and second ln-derivatives, φ_p, percolated) are replaced on the tables' own nodes
     from the spline of :func:`precompute_directional` (built here unless ``directional`` is
-    given); "average" is kept (it carries no direction), other theories are dropped. The
-    choice is recorded in ``options`` (``anisotropy``, ``direction``, ``anisotropy_form``)
-    and so in the Parquet provenance.
-    """
-    from ..tables import Tables
+    given, or taken from the columns stored by ``precompute(..., anisotropy=γ_T)``);
+    "average" is kept (it carries no direction), other theories are dropped. The choice is
+    recorded in ``options`` (``anisotropy``, ``direction``, ``anisotropy_form``) and so in
+    the Parquet provenance.
 
+    Parameters
+    ----------
+    tables : Tables
+        Tables holding "emt"; isotropic, or built with ``anisotropy=γ_T`` (then ``anisotropy``
+        may be None or must equal γ_T, and ``form`` must match).
+    anisotropy : float or None
+        Peklenik number γ_T >= 1 [-].
+    direction : {"x", "y"}
+    form : {"self_consistent", "fixed"} or None
+        Depolarization form (None: the stored one, else "self_consistent").
+    directional : DirectionalTable, optional
+        A prebuilt :func:`precompute_directional` of these tables.
+    """
     if "emt" not in tables.theories:
         raise ValueError(f"tables = {tables!r} is invalid for directional_tables: they must "
                          f"hold the 'emt' theory")
+    if _stored(tables) and directional is None:
+        g_t = table_anisotropy(tables)
+        f_t = tables.options.get("anisotropy_form", "self_consistent")
+        if anisotropy is not None and float(anisotropy) != g_t or \
+                form is not None and form != f_t:
+            raise ValueError(f"anisotropy = {anisotropy!r}, form = {form!r} are invalid for "
+                             f"these tables: they were built for γ_T = {g_t:g}, form = {f_t!r} "
+                             f"(pass anisotropy=None, or rebuild)")
+        return _stored_view(tables, _check_direction(direction))
+    if "direction" in tables.options or "anisotropy" in tables.options:
+        raise ValueError(f"tables = {tables!r} are invalid for directional_tables: they are "
+                         f"already anisotropic (options {tables.options}); start from "
+                         f"isotropic tables")
+    if anisotropy is None:
+        raise ValueError("anisotropy = None is invalid for isotropic tables: give γ_T >= 1, "
+                         "or build the tables with precompute(..., anisotropy=γ_T)")
+    form = "self_consistent" if form is None else form
     g = _check("emt", anisotropy, direction, form)
     d = directional or precompute_directional(tables, g, form=form, n_panels=n_panels)
     if d.anisotropy != g or d.form != form:
         raise ValueError(f"directional = {d!r} is invalid: built for γ_T = {d.anisotropy}, "
                          f"form = {d.form!r}, not {g}, {form!r}")
-    lnp = np.log(np.asarray(tables.data["p_over_E"], dtype=np.float64))
-    spl, n_open = d._spl[direction]
-    last = d.lnp[n_open - 1]
-    sig = d.sigma_bar(np.exp(lnp), 1.0, direction)
-    inside = (lnp <= last) & (sig > 0)
     keep = [t for t in tables.theories if t in ("average", "emt")]
-    drop = [t for t in tables.theories if t not in keep]
-    data = {k: v for k, v in tables.data.items()
-            if not any(k.endswith("_" + t) for t in drop) and k not in ("zeta_c", "u1c_over_h")}
-    data["sigma_emt"] = np.ascontiguousarray(sig)
-    data["dlnsigma_emt"] = np.ascontiguousarray(np.where(inside, spl(lnp, 1), 0.0))
-    data["d2lnsigma_emt"] = np.ascontiguousarray(np.where(inside, spl(lnp, 2), 0.0))
-    data["phi_emt"] = np.ascontiguousarray(sig / np.asarray(tables.data["u_over_h"]) ** 3)
-    data["percolated_emt"] = lnp >= d.lnp_perc[direction]
-    info = dict(tables.info)
-    perc = dict(info.get("percolation_p_over_E", {}))
-    perc = {k: v for k, v in perc.items() if k in keep}
-    perc["emt"] = math.exp(d.lnp_perc[direction])
-    info["percolation_p_over_E"] = perc
-    info["directional"] = {k: v for k, v in d.info.items()}
+    data = _drop_theories(tables, keep)
+    data.update(_columns_on_nodes(tables, d, direction))
     options = dict(tables.options, anisotropy=g, direction=direction, anisotropy_form=form)
-    return Tables(tables.surface, keep, options, tables.grid, tables.zeta_grid, data, info)
+    return _tables_with(tables, keep, data, math.exp(d.lnp_perc[direction]), options,
+                        {"directional": {k: v for k, v in d.info.items()}})

@@ -205,7 +205,8 @@ def _leak_array(sc, theory, p0x, x, com, alpha_cj, o):
 # =========================================================================== public
 def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_THEORY,
               alpha_cj=1.0, p_b=0.0, profile="uniform", R=None, f_N=None, x=None, a_perc=None,
-              solver=None, alpha_pv=0.0):
+              solver=None, alpha_pv=0.0, direction=None, viscosity="barus", roelands_z=None,
+              roelands_p_r=None, roelands_eta_inf=None):
     """Leak rate of a static seal, Q = L_y q [m³/s], for many cases at once.
 
     Steady flow across the seal width with fluid-pressure feedback (Lorenz & Persson 2010,
@@ -249,6 +250,19 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
         Barus pressure–viscosity coefficient α [1/Pa], η = η0 exp(α(p_f − p_b)); any non-zero
         value dispatches to :func:`fastcontact.seal.viscosity.seal_leak_piezo` ("uniform" and
         "hertz" profiles). 0 leaves this function's result unchanged.
+    direction : {None, "x", "y"}, default None
+        Flow direction on tables built with ``precompute(..., anisotropy=γ_T)`` (issue 14):
+        "x" along the long correlation length (the grooves), "y" across; the engine then runs
+        on :func:`fastcontact.flow.anisotropy.tables_for_direction` (σ_xx or σ_yy of the
+        anisotropic effective medium, theory "emt"; "average" has no direction;
+        "critical_junction" raises ValueError). On isotropic tables every direction gives
+        exactly the result of None (σ_xx = σ_yy = σ).
+    viscosity : {"barus", "roelands"}, default "barus"
+        Pressure–viscosity law. "roelands" dispatches to
+        :func:`fastcontact.seal.viscosity.seal_leak_piezo` (numerical Reynolds solution; the
+        reduced pressure does not apply), with ``roelands_z`` [-] (None: Z from ``alpha_pv``
+        as the initial slope), ``roelands_p_r`` [Pa] and ``roelands_eta_inf`` [Pa·s] (None:
+        Hamrock & Dowson's constants, :mod:`fastcontact.flow.piezoviscosity`).
 
     Returns
     -------
@@ -273,10 +287,15 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
     ----------
     B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10621-2
     """
-    if np.any(np.asarray(alpha_pv, dtype=np.float64) != 0.0):      # issue 14: Barus fluid
+    if direction is not None:                  # issue 14: anisotropic roughness (σ_xx, σ_yy)
+        from ..flow.anisotropy import tables_for_direction
+        tables = tables_for_direction(check_tables(tables), direction, theory)
+    if viscosity != "barus" or np.any(np.asarray(alpha_pv, dtype=np.float64) != 0.0):
         return seal_leak_piezo(tables, p0=p0, dp=dp, L=L, L_y=L_y, E_star=E_star, eta=eta,
                                alpha_pv=alpha_pv, theory=theory, alpha_cj=alpha_cj, p_b=p_b,
-                               profile=profile, R=R, f_N=f_N)
+                               profile=profile, R=R, f_N=f_N, viscosity=viscosity,
+                               roelands_z=roelands_z, roelands_p_r=roelands_p_r,
+                               roelands_eta_inf=roelands_eta_inf)   # issue 14: η(p) fluids
     check_tables(tables)
     al = align_inputs(p0=p0, dp=dp, L=L, L_y=L_y, E_star=E_star, eta=eta, p_b=p_b, R=R,
                       f_N=f_N)                               # pandas inputs paired by label

@@ -15,6 +15,17 @@ conductivity σ0 at the outlet viscosity η0 and the reduced pressure
 
 In both, ``p_f(ψ) = p_b - ln(1 - αψ)/α``; ψ < 1/α always since ψ_a = ψ(p_a) < 1/α.
 
+**Roelands** (``viscosity="roelands"``, :mod:`fastcontact.flow.piezoviscosity`):
+ln(η/η0) = A[(1 + (p_f - p_b)/p_r)^Z - 1]. The reduced-pressure trick does **not** carry
+over: ψ(p) = ∫η0/η dp is an incomplete gamma function with no closed-form inverse, and
+p_cont = p0(x) - p_f needs p_f(ψ). So
+
+* uniform ring: the separated equation holds for any η(p),
+  ``q L = ∫_{p_b}^{p_a} σ0(p0 - p) η0/η(p) dp`` (same quadrature, Roelands weight);
+* Hertz O-ring: the Reynolds equation is integrated in p_f itself,
+  dp_f/dθ = -k a sin θ (η(p_f)/η0)/σ̄((p_H sin θ - p_f)/E*), by the same graded RK4 and
+  shooting on k (no ψ anywhere).
+
 References: C. Barus, Am. J. Sci. 45, 87 (1893), doi:10.2475/ajs.s3-45.266.87;
 B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019.
 """
@@ -27,6 +38,8 @@ import pandas as pd
 from numba import njit, prange
 
 from .._core.validate import check_positive
+from ..flow.piezoviscosity import (ROELANDS_ETA_INF, check_law, ln_roelands,
+                                   roelands_parameters)
 from ..tables import k_sigma_of_lnp
 
 __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
@@ -184,6 +197,127 @@ def _hertz_kernel(tab, sc, E, pH, a, pa, pb, alpha, n, k, ok):
         k[i], ok[i] = _hertz_case(tab, sc, E[i], pH[i], a[i], pa[i], pb[i], alpha[i], n)
 
 
+# =========================================================================== Roelands
+@njit(cache=True)
+def _uniform_integral_r(tab, sc, E, p0, pa, pb, A, Z, pr, glx, glw, width):
+    """∫_{p_b}^{p_a} σ̄(p0 - p) η0/η(p - p_b) dp [Pa] (Roelands), in x = ln((p0 - p)/E*)."""
+    xb = math.log((p0 - pb) / E)
+    if pa >= p0:
+        xa = sc[0] - TAIL_CUT
+    else:
+        xa = math.log((p0 - pa) / E)
+        xa = max(xa, sc[0] - TAIL_CUT)
+    if not xb > xa:
+        return 0.0
+    m = max(1, int(math.ceil((xb - xa) / width)))
+    hw = (xb - xa) / m
+    s = 0.0
+    for k in range(m):
+        mid = xa + (k + 0.5) * hw
+        for j in range(glx.size):
+            x = mid + 0.5 * hw * glx[j]
+            pc = E * math.exp(x)
+            s += 0.5 * hw * glw[j] * _sigma(tab, sc, x) * pc * math.exp(
+                -ln_roelands(max(p0 - pb - pc, 0.0), A, Z, pr))
+    return s
+
+
+@njit(parallel=True, cache=True)
+def _uniform_kernel_r(tab, sc, p0, L, pa, pb, E, A, Z, pr, glx, glw, width, out):
+    for i in prange(p0.size):
+        out[i] = _uniform_integral_r(tab, sc, E[i], p0[i], pa[i], pb[i], A[i], Z[i], pr, glx,
+                                     glw, width) / L[i]
+
+
+@njit(cache=True)
+def _rhs_r(tab, sc, E, pH, a, th_s, span, t, p, pb, A, Z, pr, k):
+    """dp_f/dt = -k a sin θ (η/η0)/σ̄(p0(θ) - p_f) dθ/dt; 0 in an open pocket."""
+    th = th_s + span * t * t * (3.0 - 2.0 * t)
+    pc = pH * math.sin(th) - p
+    if pc <= 0.0:
+        return 0.0
+    s = _sigma(tab, sc, math.log(pc / E))
+    if s <= 0.0:
+        return -1e300
+    lv = ln_roelands(max(p - pb, 0.0), A, Z, pr)
+    return -k * a * math.sin(th) * math.exp(lv) / s * span * 6.0 * t * (1.0 - t)
+
+
+@njit(cache=True)
+def _shoot_r(tab, sc, E, pH, a, th_s, th_e, pa, pb, A, Z, pr, k, n):
+    """p_f - p_b at the outlet end θ_e for k = 12 η0 q / h³ (RK4 on the graded t of _shoot)."""
+    h = 1.0 / n
+    span = th_e - th_s
+    p = pa
+    floor = pb - 10.0 * (pa - pb)
+    for i in range(n):
+        t0 = i * h
+        k1 = _rhs_r(tab, sc, E, pH, a, th_s, span, t0, p, pb, A, Z, pr, k)
+        k2 = _rhs_r(tab, sc, E, pH, a, th_s, span, t0 + 0.5 * h, p + 0.5 * h * k1, pb, A, Z, pr, k)
+        k3 = _rhs_r(tab, sc, E, pH, a, th_s, span, t0 + 0.5 * h, p + 0.5 * h * k2, pb, A, Z, pr, k)
+        k4 = _rhs_r(tab, sc, E, pH, a, th_s, span, t0 + h, p + h * k3, pb, A, Z, pr, k)
+        p += h * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0
+        if p < floor or p != p:
+            return floor - pb
+    return p - pb
+
+
+@njit(cache=True)
+def _hertz_case_r(tab, sc, E, pH, a, pa, pb, A, Z, pr, n):
+    """(k, converged) of one Hertz case with a Roelands fluid (bracket + Illinois in ln k)."""
+    dpa = pa - pb
+    th_s = math.asin(min(1.0, pa / pH))
+    th_e = math.pi - math.asin(min(1.0, pb / pH))
+    smid = _sigma(tab, sc, math.log(max(pH - 0.5 * (pa + pb), 1e-300) / E))
+    y = math.log(dpa * max(smid, 1e-300) / (2.0 * a))
+    f = _shoot_r(tab, sc, E, pH, a, th_s, th_e, pa, pb, A, Z, pr, math.exp(y), n)
+    lo = y
+    hi = y
+    flo = f
+    fhi = f
+    step = 2.0
+    for _ in range(400):
+        if flo > 0.0 and fhi < 0.0:
+            break
+        if f > 0.0:
+            hi = lo + step
+            fhi = _shoot_r(tab, sc, E, pH, a, th_s, th_e, pa, pb, A, Z, pr, math.exp(hi), n)
+            if fhi > 0.0:
+                lo, flo = hi, fhi
+        else:
+            lo = hi - step
+            flo = _shoot_r(tab, sc, E, pH, a, th_s, th_e, pa, pb, A, Z, pr, math.exp(lo), n)
+            if flo < 0.0:
+                hi, fhi = lo, flo
+        f = flo if flo > 0.0 else fhi
+        step *= 1.5
+    if not (flo > 0.0 and fhi < 0.0):
+        return math.nan, False
+    side = 0
+    for _ in range(200):
+        y = (lo * fhi - hi * flo) / (fhi - flo)
+        f = _shoot_r(tab, sc, E, pH, a, th_s, th_e, pa, pb, A, Z, pr, math.exp(y), n)
+        if f > 0.0:
+            lo, flo = y, f
+            if side == 1:
+                fhi *= 0.5
+            side = 1
+        else:
+            hi, fhi = y, f
+            if side == -1:
+                flo *= 0.5
+            side = -1
+        if hi - lo < 1e-13 or abs(f) <= 1e-14 * dpa:
+            return math.exp(y), True
+    return math.exp(y), False
+
+
+@njit(parallel=True, cache=True)
+def _hertz_kernel_r(tab, sc, E, pH, a, pa, pb, A, Z, pr, n, k, ok):
+    for i in prange(E.size):
+        k[i], ok[i] = _hertz_case_r(tab, sc, E[i], pH[i], a[i], pa[i], pb[i], A[i], Z[i], pr, n)
+
+
 # =========================================================================== API
 def _scalars(tables, theory):
     """(x_min, v_top, u0, ln σ̄_top, x_max, x_perc) of (tables, theory)."""
@@ -198,8 +332,9 @@ def _scalars(tables, theory):
 
 def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_junction",
                     alpha_cj=1.0, p_b=0.0, profile="uniform", p0=None, L=None, R=None, f_N=None,
-                    quad_order=10, quad_width=0.5, steps=HERTZ_STEPS):
-    """Leak rate Q [m³/s] of a seal with a Barus fluid, uniform ring or Hertz O-ring.
+                    quad_order=10, quad_width=0.5, steps=HERTZ_STEPS, viscosity="barus",
+                    roelands_z=None, roelands_p_r=None, roelands_eta_inf=None):
+    """Leak rate Q [m³/s] of a seal with a Barus or Roelands fluid, uniform ring or O-ring.
 
     Parameters
     ----------
@@ -214,10 +349,12 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
     eta : array_like
         Viscosity η0 at the outlet pressure p_b [Pa·s].
     alpha_pv : array_like
-        Pressure–viscosity coefficient α [1/Pa], >= 0; η = η0 exp(α (p_f - p_b)).
+        Pressure–viscosity coefficient α [1/Pa], >= 0; η = η0 exp(α (p_f - p_b)) (Barus).
+        Roelands: the initial slope d ln η/dp at p_b, which sets Z = α p_r/ln(η0/η_∞) when
+        ``roelands_z`` is None.
     theory : str
         Flow theory of σ_eff (must be in the tables).
-    alpha_cj : float
+    alpha_cj : array_like
         Critical-junction factor [-]: σ ∝ α_cj³, so Q is rescaled by (α_cj/α_table)³
         exactly (q is linear in σ in both profiles); ignored by the other theories.
     p_b : array_like
@@ -228,11 +365,22 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         Gauss–Legendre order and panel width in ln p_cont (uniform ring).
     steps : int
         RK4 steps across the Hertz sealing zone.
+    viscosity : {"barus", "roelands"}
+        Viscosity law (module docstring; :mod:`fastcontact.flow.piezoviscosity`). Roelands:
+        ln(η/η0) = ln(η0/η_∞)[(1 + (p_f - p_b)/p_r)^Z - 1], solved without the reduced
+        pressure (it does not apply).
+    roelands_z : array_like or None
+        Roelands pressure–viscosity index Z [-] >= 0 (None: from ``alpha_pv``).
+    roelands_p_r : float or None
+        Roelands reference pressure p_r [Pa] (None: 1/5.1e-9 ≈ 1.96e8, Hamrock & Dowson).
+    roelands_eta_inf : float or None
+        Roelands limiting viscosity η_∞ [Pa·s] (None: e^-9.67 ≈ 6.3e-5); ``eta`` must exceed it.
 
     Returns
     -------
     pandas.DataFrame
-        ``Q`` [m³/s] (inf beyond lift-off, 0 if percolated or dp = 0), ``lift_off``,
+        ``Q`` [m³/s] (inf beyond lift-off, 0 if percolated or dp = 0), ``open_inlet``,
+        ``open_outlet`` [m] (zones with p0 <= p_f; Hertz also ``L`` = 2a), ``lift_off``,
         ``percolated``, ``converged`` (Hertz shooting), ``out_of_table`` (the largest
         contact pressure lies beyond the tables: Q = NaN), ``status`` ("ok", "lift_off"
         (p_a = max p0: finite limit), "open" (Q = inf), "percolated", "above_table",
@@ -252,6 +400,9 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
     eta = check_positive("eta", eta, "[Pa·s]")
     alpha_pv = check_positive("alpha_pv", alpha_pv, "[1/Pa]", allow_zero=True)
     p_b = check_positive("p_b", p_b, "[Pa]", allow_zero=True)
+    roelands = check_law(viscosity) == "roelands"
+    zz = np.array(math.nan) if roelands_z is None else check_positive(
+        "roelands_z", roelands_z, "[-]", allow_zero=True)
     if profile == "uniform":
         if p0 is None or L is None or R is not None or f_N is not None:
             raise ValueError("profile = 'uniform' is invalid with these arguments: give p0 [Pa] "
@@ -264,10 +415,16 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
                              "and f_N [N/m], not p0 / L")
         g1 = check_positive("R", R, "[m]")
         g2 = check_positive("f_N", f_N, "[N/m]")
-    shape = np.broadcast(dp, L_y, E_star, eta, alpha_pv, p_b, g1, g2).shape
-    dp, L_y, E, eta, al, pb, g1, g2 = (
+    a_cj = check_positive("alpha_cj", alpha_cj, "[-]")
+    shape = np.broadcast(dp, L_y, E_star, eta, alpha_pv, p_b, g1, g2, zz, a_cj).shape
+    dp, L_y, E, eta, al, pb, g1, g2, zz, a_cj = (
         np.ascontiguousarray(np.broadcast_to(v, shape).ravel(), dtype=np.float64)
-        for v in (dp, L_y, E_star, eta, alpha_pv, p_b, g1, g2))
+        for v in (dp, L_y, E_star, eta, alpha_pv, p_b, g1, g2, zz, a_cj))
+    if roelands:
+        rA, rZ, rpr = roelands_parameters(eta, al, None if roelands_z is None else zz,
+                                          roelands_p_r, roelands_eta_inf)
+        rA = np.ascontiguousarray(rA, dtype=np.float64)
+        rZ = np.ascontiguousarray(rZ, dtype=np.float64)
     h = float(tables.h_rms)
     sc = _scalars(tables, theory)
     tab = tables.kernel_data(theory)
@@ -284,9 +441,13 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         run = ~lift & ~perc & ~out_t & (dp > 0)
         if np.any(run):
             x, w = np.polynomial.legendre.leggauss(int(quad_order))
-            sub = [np.ascontiguousarray(v[run]) for v in (p0v, Lv, pa, pb, E, al)]
             out = np.empty(int(run.sum()))
-            _uniform_kernel(tab, sc, *sub, x, w, float(quad_width), out)
+            if roelands:
+                sub = [np.ascontiguousarray(v[run]) for v in (p0v, Lv, pa, pb, E, rA, rZ)]
+                _uniform_kernel_r(tab, sc, *sub, rpr, x, w, float(quad_width), out)
+            else:
+                sub = [np.ascontiguousarray(v[run]) for v in (p0v, Lv, pa, pb, E, al)]
+                _uniform_kernel(tab, sc, *sub, x, w, float(quad_width), out)
             kq[run] = out
         conv = np.ones(E.size, dtype=bool)
         cols.update({"p0": p0v, "L": Lv})
@@ -300,30 +461,55 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         conv = np.ones(E.size, dtype=bool)
         run = ~lift & ~perc & ~out_t & (dp > 0)
         if np.any(run):
-            sub = [np.ascontiguousarray(v[run]) for v in (E, pH, a, pa, pb, al)]
             k = np.empty(int(run.sum()))
             ok = np.empty(int(run.sum()), dtype=np.bool_)
-            _hertz_kernel(tab, sc, *sub, int(steps), k, ok)
+            if roelands:
+                sub = [np.ascontiguousarray(v[run]) for v in (E, pH, a, pa, pb, rA, rZ)]
+                _hertz_kernel_r(tab, sc, *sub, rpr, int(steps), k, ok)
+            else:
+                sub = [np.ascontiguousarray(v[run]) for v in (E, pH, a, pa, pb, al)]
+                _hertz_kernel(tab, sc, *sub, int(steps), k, ok)
             kq[run] = k
             conv[run] = ok
         cols.update({"R": g1, "f_N": g2, "a": a, "p_max": pH})
     scale = 1.0
     if theory == "critical_junction":
-        a_cj = float(check_positive("alpha_cj", alpha_cj, "[-]"))
         scale = (a_cj / float(tables.options.get("alpha_cj", 1.0))) ** 3
     Q = scale * L_y * kq * h ** 3 / (12.0 * eta)
     Q = np.where(lift, math.inf, np.where(conv & ~out_t, Q, math.nan))
     pmax = p0v if profile == "uniform" else pH
     status = np.select([lift, pa == pmax, perc, out_t, ~conv],
                        ["open", "lift_off", "percolated", "above_table", "not_converged"], "ok")
+    if profile == "uniform":
+        open_in = np.where(pa > p0v, Lv, 0.0)
+        open_out = np.zeros_like(Lv)
+    else:
+        with np.errstate(invalid="ignore"):
+            sa = np.clip(pa / pH, 0.0, 1.0)
+            sb = np.clip(pb / pH, 0.0, 1.0)
+            open_in = np.where(~lift, a * (1.0 - np.sqrt(1.0 - sa * sa)), 2 * a)
+            open_out = np.where(~lift, a * (1.0 - np.sqrt(1.0 - sb * sb)), 0.0)
+        cols["L"] = 2 * a
+    cols.update({"open_inlet": open_in, "open_outlet": open_out})
     cols.update({"p_a": pa, "Q": Q, "lift_off": lift | (pa == pmax), "percolated": perc,
                  "converged": conv, "out_of_table": out_t, "status": status})
+    if roelands:
+        cols["roelands_z"] = rZ
     df = pd.DataFrame(cols, copy=False)
+    refs = ["doi:10.2475/ajs.s3-45.266.87", "arXiv:0911.3019"]
+    if roelands:
+        refs = ["C.J.A. Roelands, PhD thesis, TU Delft (1966)",
+                "B.J. Hamrock and D. Dowson, Ball Bearing Lubrication, Wiley (1981), eq. 4.5",
+                "arXiv:0911.3019"]
     df.attrs.update({"units": {"Q": "m^3/s", "dp": "Pa", "p_a": "Pa", "p_b": "Pa", "p0": "Pa",
                                "L": "m", "L_y": "m", "E_star": "Pa", "eta": "Pa s",
                                "alpha_pv": "1/Pa", "R": "m", "f_N": "N/m", "a": "m",
-                               "p_max": "Pa"},
-                     "theory": theory, "profile": profile, "viscosity": "Barus",
-                     "shape": tuple(shape),
-                     "references": ["doi:10.2475/ajs.s3-45.266.87", "arXiv:0911.3019"]})
+                               "p_max": "Pa", "roelands_z": "1", "open_inlet": "m",
+                               "open_outlet": "m"},
+                     "theory": theory, "profile": profile,
+                     "viscosity": "Roelands" if roelands else "Barus",
+                     "shape": tuple(shape), "references": refs})
+    if roelands:
+        df.attrs.update(roelands_p_r=float(rpr), roelands_eta_inf=float(
+            ROELANDS_ETA_INF if roelands_eta_inf is None else roelands_eta_inf))
     return df

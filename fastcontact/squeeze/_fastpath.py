@@ -8,13 +8,65 @@ the trap pressure) fall back to the per-case quadrature in the same pass.
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
+import numpy as np
 from numba import njit, prange
 
 from . import _kernels as qk
 from .primitive import row_value, stencil, t_of_z, z_of_t
 
-__all__ = ["fast_kernel", "history_kernel"]
+__all__ = ["fast_kernel", "history_kernel", "one_case_primitive", "RowTargets", "row_targets"]
+
+#: per-call tables on the primitive's rows: lnT (nx, 1 + nr) = ln T at the case-independent
+#: targets (t_star: ū = 1.01 ū∞, then the ratios), lnTs (nx) = ln T at the default start.
+#: A case interpolates them in x0 with the same 4-point stencil as everything else, so a
+#: default-start ratio target costs four loads and one exp.
+RowTargets = namedtuple("RowTargets", "lnT lnTs")
+#: a per-case start within GUARD_Z (in z = ln(ū/ū∞ - 1)) above a target takes the target
+#: from the same interpolant as the start (t_of_z), so that the difference stays >= 0
+GUARD_Z = 1.0
+
+
+@njit(cache=True, inline="always")
+def _row_stencil(pr, j):
+    """The stencil of row j itself (weight 1 on row j)."""
+    n = pr.xn.size
+    j0 = j - 1
+    if j0 < 0:
+        j0 = 0
+    if j0 > n - 4:
+        j0 = n - 4
+    r = j - j0
+    return (j0, 1.0 if r == 0 else 0.0, 1.0 if r == 1 else 0.0, 1.0 if r == 2 else 0.0,
+            1.0 if r == 3 else 0.0)
+
+
+@njit(parallel=True, cache=True)
+def _row_targets_kernel(pr, ratios, lnT, lnTs):
+    for j in prange(pr.xn.size):
+        st = _row_stencil(pr, j)
+        vinf = math.exp(pr.lnv[j])
+        lnTs[j] = math.log(t_of_z(pr, st, vinf, pr.zs[j]))
+        for k in range(lnT.shape[1]):
+            r1 = 0.01 if k == 0 else ratios[k - 1] - 1.0
+            lnT[j, k] = math.log(t_of_z(pr, st, vinf, math.log(r1)))
+
+
+def row_targets(pr, ratios):
+    """The :data:`RowTargets` of the primitive ``pr`` for these ratio targets (~1 ms)."""
+    ratios = np.ascontiguousarray(ratios, dtype=np.float64)
+    lnT = np.empty((pr.xn.size, 1 + ratios.size))
+    lnTs = np.empty(pr.xn.size)
+    _row_targets_kernel(pr, ratios, lnT, lnTs)
+    return RowTargets(lnT, lnTs)
+
+
+@njit(cache=True, inline="always")
+def _row_col(A, st, k):
+    """Σ_r w_r A[j0 + r, k]."""
+    j0 = st[0]
+    return st[1] * A[j0, k] + st[2] * A[j0 + 1, k] + st[3] * A[j0 + 2, k] + st[4] * A[j0 + 3, k]
 
 
 @njit(cache=True)
@@ -32,92 +84,157 @@ def _start(pr, st, vinf, vs_in):
 
 
 @njit(cache=True)
-def _targets(pr, st, vinf, vs, Ts, tg, tau, i, out):
-    """Times [s] to t_star (ū = 1.01 ū∞), the ratios and the Δu targets; 0 if passed."""
-    nr = tg.ratios.size
-    for k in range(out.T.shape[0]):
-        if k == 0:
-            r1 = 0.01
-        elif k <= nr:
-            r1 = tg.ratios[k - 1] - 1.0
-        else:
-            r1 = tg.dvs[k - 1 - nr] / vinf
-        if vinf * (1.0 + r1) >= vs:
-            out.T[k, i] = 0.0
-        else:
-            out.T[k, i] = tau * (t_of_z(pr, st, vinf, math.log(r1)) - Ts)
+def _slow_row(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
+    """A row the primitive does not serve (outside the tables, trapped side): per-case
+    quadrature, then the overflow flag (a plain call: big records by value are fine here,
+    these rows are rare)."""
+    qk.quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
+    _flag_overflow(tau, tg, h, i, out)
 
 
 @njit(cache=True)
-def _times(pr, st, vinf, vs, Ts, tg, tau, h, i, out):
-    """ū [m] at the times of row i (shared or per case)."""
-    col = i if tg.times.shape[1] > 1 else i - i  # same integer type as i
-    for k in range(out.U.shape[0]):
-        tk = tg.times[k, col] / tau
-        if tk == 0.0:
-            out.U[k, i] = vs * h
-        elif tk == math.inf:
-            out.U[k, i] = vinf * h
-        else:
-            z = z_of_t(pr, st, vinf, Ts + tk)
-            # ū(t) <= ū(0): the inverse interpolation can land an ulp above the start for
-            # t → 0; keep the ODE's monotonicity exactly (a round-off bound, not a clamp of data)
-            out.U[k, i] = min(vinf * (1.0 + math.exp(z)), vs) * h
-
-
-@njit(cache=True)
-def fast_case(tab, mp, pr, x_fast, x0, vs_in, tg, tau, h, quad, i, out):
-    """Everything for one case from the primitive, written in SI to column i of ``out``."""
-    if not (mp.x_min <= x0 <= mp.x_max):
-        qk.quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)  # writes the NaN row
-        return
-    if x0 > x_fast:
-        qk.quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
-        return
-    st = stencil(pr, x0)
-    vinf = math.exp(row_value(pr.lnv, st))
+def _below_row(vinf, vs_in, h, x0, i, out):
+    """A row whose given start is at or below ū∞: NaN outputs, status explains."""
+    qk._nan_row(out, i, x0)
     out.u_inf[i] = vinf * h
-    if not (vs_in != vs_in or vs_in > vinf):
-        qk._nan_row(out, i, x0)
-        out.u_inf[i] = vinf * h
-        out.u_start[i] = vs_in * h
-        out.status[i] = qk.ST_BELOW
-        return
-    vs, Ts = _start(pr, st, vinf, vs_in)
-    out.u_start[i] = vs * h
-    out.t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
-    out.u_trap[i] = math.nan
-    out.t_trap[i] = math.inf
-    out.flf[i] = 0.0
-    out.status[i] = qk.ST_OK
-    _targets(pr, st, vinf, vs, Ts, tg, tau, i, out)
-    _times(pr, st, vinf, vs, Ts, tg, tau, h, i, out)
+    out.u_start[i] = vs_in * h
+    out.status[i] = qk.ST_BELOW
 
 
 @njit(cache=True)
-def _flag_overflow(tau, i, out):
-    """Write τ0; status "overflow" where τ0 or a time is not representable (inf or 0) on a
-    computed row. (Writes happen in this callee: a setitem on a record field directly in
-    the prange body is lost by numba's parfor lowering.)"""
-    out.tau0[i] = tau
-    if out.status[i] != qk.ST_OK:
+def _flag_overflow(tau, tg, h, i, out):
+    """Status "overflow" where τ0 or a time is not representable (inf) on a computed row.
+
+    On a trapped row the times to targets at or below ū_trap are inf by the physics (never
+    reached); only τ0, t_trap and the times to targets above ū_trap can overflow."""
+    st = out.status[i]
+    if st != qk.ST_OK and st != qk.ST_TRAPPED:
         return
     bad = not (0.0 < tau < math.inf)
+    nr = tg.ratios.size
+    u_inf = out.u_inf[i]
+    trapped = st == qk.ST_TRAPPED
+    if trapped and out.t_trap[i] == math.inf and out.u_start[i] > out.u_trap[i]:
+        bad = True
     for k in range(out.T.shape[0]):
         if out.T[k, i] == math.inf:
-            bad = True
+            if k == 0:
+                ut = 1.01 * u_inf
+            elif k <= nr:
+                ut = tg.ratios[k - 1] * u_inf
+            else:
+                ut = u_inf + tg.dvs[k - 1 - nr] * h
+            if not trapped or ut > out.u_trap[i]:
+                bad = True
     if bad:
         out.status[i] = qk.ST_OVERFLOW
 
 
 @njit(parallel=True, cache=True)
-def fast_kernel(tab, mp, pr, x_fast, cs, h, tg, quad, out):
-    """method="fast": every case from the primitive (fall-back rows by quadrature)."""
-    for i in prange(cs.p0.size):
-        tau = 3.0 * cs.eta[i] * cs.R[i] * cs.R[i] / (2.0 * h * h * cs.p0[i])
-        fast_case(tab, mp, pr, x_fast, math.log(cs.p0[i] / cs.E[i]), cs.us[i] / h, tg, tau, h,
-                  quad, i, out)
-        _flag_overflow(tau, i, out)
+def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
+    """method="fast": every case from the primitive (fall-back rows by quadrature).
+
+    The records are unpacked into plain arrays before the parallel loop, and the per-case
+    work is inline in its body: a call per case with the records by value costs ten times
+    the arithmetic. Ratio targets (same z for every case) come from the row tables ``rt``
+    unless the start lies within GUARD_Z above them (then from the start's interpolant
+    t_of_z, so that the difference stays >= 0); Δu targets from t_of_z; ū at times from the
+    inverse z_of_t."""
+    # one field per statement: with tuple unpacking (a, b = rec.a, rec.b) numba 0.6x's parfor
+    # lowering keeps only the first array's writes, and a record-field setitem in the loop
+    # body (rec.a[i] = x) is lost as well
+    T_out = out.T
+    U_out = out.U
+    tau0 = out.tau0
+    status = out.status
+    u_inf = out.u_inf
+    u_start = out.u_start
+    t_relax = out.t_relax
+    u_trap = out.u_trap
+    t_trap = out.t_trap
+    flf = out.flf
+    p0 = cs.p0
+    E = cs.E
+    R = cs.R
+    eta = cs.eta
+    us = cs.us
+    ratios = tg.ratios
+    dvs = tg.dvs
+    times = tg.times
+    lnT = rt.lnT
+    lnTs = rt.lnTs
+    x_lo, x_hi = mp.x_min, min(mp.x_max, x_fast)
+    nT, nU, nr = T_out.shape[0], U_out.shape[0], ratios.size
+    per_case_times = times.shape[1] > 1
+    r1s = np.empty(1 + nr)  # ū/ū∞ - 1 of t_star and the ratios, and its log
+    r1s[0] = 0.01
+    for k in range(nr):
+        r1s[k + 1] = ratios[k] - 1.0
+    zr = np.log(r1s)
+    for i in prange(p0.size):
+        tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
+        x0 = math.log(p0[i] / E[i])
+        vs_in = us[i] / h
+        tau0[i] = tau
+        if not (x_lo <= x0 <= x_hi):
+            _slow_row(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
+        else:
+            st = stencil(pr, x0)
+            vinf = math.exp(row_value(pr.lnv, st))
+            if not (vs_in != vs_in or vs_in * h > vinf * h):  # as reported (SI)
+                _below_row(vinf, vs_in, h, x0, i, out)
+            else:
+                if vs_in != vs_in:  # the default start: its T from the row table
+                    zs = row_value(pr.zs, st)
+                    vs = vinf * (1.0 + math.exp(zs))
+                    Ts = math.exp(row_value(lnTs, st))
+                elif vs_in == math.inf:
+                    zs, vs, Ts = math.inf, vs_in, 0.0
+                else:
+                    vs = vs_in
+                    zs = math.log(vs / vinf - 1.0)
+                    Ts = t_of_z(pr, st, vinf, zs)
+                u_inf[i] = vinf * h
+                u_start[i] = vs * h
+                t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
+                u_trap[i] = math.nan
+                t_trap[i] = math.inf
+                flf[i] = 0.0
+                bad = not (0.0 < tau < math.inf)
+                for k in range(nT):
+                    if k <= nr:
+                        r1 = r1s[k]
+                    else:
+                        r1 = dvs[k - 1 - nr] / vinf
+                    if vinf * (1.0 + r1) >= vs:
+                        tk = 0.0
+                    else:
+                        z = zr[k] if k <= nr else math.log(r1)
+                        if k <= nr and z < zs - GUARD_Z:
+                            Tk = math.exp(_row_col(lnT, st, k))
+                        else:
+                            Tk = t_of_z(pr, st, vinf, z)
+                        tk = tau * (Tk - Ts)
+                    T_out[k, i] = tk
+                    if tk == math.inf:
+                        bad = True
+                for k in range(nU):
+                    tt = times[k, i if per_case_times else i - i] / tau
+                    if tt == 0.0:
+                        U_out[k, i] = vs * h
+                    elif tt == math.inf:
+                        U_out[k, i] = vinf * h
+                    else:
+                        z = z_of_t(pr, st, vinf, Ts + tt)
+                        # ū(t) <= ū(0): the inverse can land an ulp above the start for
+                        # t → 0; keeps the ODE's monotonicity (a round-off bound, not a clamp)
+                        U_out[k, i] = min(vinf * (1.0 + math.exp(z)), vs) * h
+                status[i] = qk.ST_OVERFLOW if bad else qk.ST_OK
+
+
+@njit(cache=True)
+def _tau0(tau, i, out):
+    out.tau0[i] = tau  # in a callee: a record-field setitem in the prange body is lost
 
 
 @njit(parallel=True, cache=True)
@@ -125,15 +242,40 @@ def quad_kernel(tab, mp, cs, h, tg, quad, out):
     """method="quad": every case by per-case quadrature (one prange pass)."""
     for i in prange(cs.p0.size):
         tau = 3.0 * cs.eta[i] * cs.R[i] * cs.R[i] / (2.0 * h * h * cs.p0[i])
-        qk.quad_case(tab, mp, math.log(cs.p0[i] / cs.E[i]), cs.us[i] / h, tg, tau, h, quad, i,
-                     out)
-        _flag_overflow(tau, i, out)
+        _slow_row(tab, mp, math.log(cs.p0[i] / cs.E[i]), cs.us[i] / h, tg, tau, h, quad, i,
+                  out)
+        _tau0(tau, i, out)
+
+
+def _one_row(arr, st):
+    """A 4-row array whose first row is the stencil's combination of ``arr`` (others 0)."""
+    j0, w0, w1, w2, w3 = st
+    out = np.zeros((4,) + arr.shape[1:])
+    out[0] = w0 * arr[j0] + w1 * arr[j0 + 1] + w2 * arr[j0 + 2] + w3 * arr[j0 + 3]
+    return out
+
+
+def one_case_primitive(pr, x0):
+    """(primitive, stencil) of the single pressure x0 = ln(p0/E*): the four rows combined
+    once, so that every later lookup reads one small row that stays in cache (the same
+    arithmetic as combining per lookup: weights 1, 0, 0, 0 reproduce it exactly)."""
+    from .primitive import Primitive, stencil as _st
+
+    st = _st(pr, x0)
+    if st[0] < 0:
+        return None, st
+    one = (0, 1.0, 0.0, 0.0, 0.0)
+    xn = np.array([x0 - 1.0, x0, x0 + 1.0, x0 + 2.0])
+    pr1 = Primitive(xn, float(xn[0]), 1.0, np.arange(4.0), pr.z0, pr.dz, pr.nz,
+                    np.ascontiguousarray(_one_row(pr.C, st)), _one_row(pr.lnv, st),
+                    _one_row(pr.lnS, st), _one_row(pr.zs, st), _one_row(pr.sx, st),
+                    _one_row(pr.lk, st), pr.v_ext, pr.c, pr.d)
+    return pr1, one
 
 
 @njit(parallel=True, cache=True)
-def history_kernel(pr, x0, vs_in, tau, h, t, u):
-    """ū [m] of one case (on the primitive's rows) at the times t [s]."""
-    st = stencil(pr, x0)
+def history_kernel(pr, st, vs_in, tau, h, t, u):
+    """ū [m] of one case at the times t [s]; ``pr, st`` from :func:`one_case_primitive`."""
     vinf = math.exp(row_value(pr.lnv, st))
     vs, Ts = _start(pr, st, vinf, vs_in)
     for k in prange(t.size):

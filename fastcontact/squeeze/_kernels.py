@@ -37,6 +37,12 @@ ST_OK, ST_TRAPPED, ST_OUT, ST_BELOW, ST_OVERFLOW = 0, 1, 2, 3, 4
 STATUS_NAMES = ("ok", "trapped", "out_of_table", "start_below_equilibrium", "overflow")
 
 
+def trapped_mask(status, u_trap):
+    """The ``trapped`` column: fluid trapped by the physics (ū_trap set), also on rows whose
+    status says "overflow" (τ0 or a time not representable)."""
+    return (status == ST_TRAPPED) | ((status == ST_OVERFLOW) & np.isfinite(u_trap))
+
+
 @njit(cache=True)
 def _state(tab, mp, v):
     """(ln π_c, σ̄) at separation v [h_rms]: tables, or the analytic tail above v_top."""
@@ -143,6 +149,13 @@ def _time(tab, mp, x0, vb, v_lo, v_hi, quad):
     """t̃ to go from v_hi (may be inf) down to v_lo > vb."""
     if not (v_hi > v_lo):
         return 0.0
+    return _time_w(tab, mp, x0, vb, v_lo, math.log(v_lo - vb), v_hi, math.log(v_hi - vb), quad)
+
+
+@njit(cache=True)
+def _time_w(tab, mp, x0, vb, v_lo, w_lo, v_hi, w_hi, quad):
+    """t̃ from v_hi (may be inf) down to v_lo, the ends also given as w = ln(v - vb) (exact
+    even where v - vb is below the resolution of v, e.g. ū∞ + 1e-20 m)."""
     total = 0.0
     v_ext = mp.v_ext
     if v_hi > v_ext:
@@ -150,8 +163,10 @@ def _time(tab, mp, x0, vb, v_lo, v_hi, quad):
         total += _tail_int(mp.c, a + mp.d, v_hi + mp.d)
         if v_lo >= v_ext:
             return total
-        v_hi = v_ext
-    return total + _seg(tab, mp, x0, vb, math.log(v_lo - vb), math.log(v_hi - vb), quad)
+        w_hi = math.log(v_ext - vb)
+    if not (w_hi > w_lo):
+        return total
+    return total + _seg(tab, mp, x0, vb, w_lo, w_hi, quad)
 
 
 @njit(cache=True)
@@ -264,8 +279,18 @@ def _case_targets(tab, mp, x0, vinf, vs, vb, trapped, tg, tau, quad, i, out):
             vts[k] = tg.ratios[k - 1] * vinf
         else:
             vts[k] = vinf + tg.dvs[k - 1 - nr]
-    order = np.argsort(-vts)
+    # w = ln(v - v∞) of each target, exact (a Δu below the resolution of ū∞ stays apart)
+    wts = np.empty(nt)
+    for k in range(nt):
+        if k == 0:
+            wts[k] = math.log(0.01) + math.log(vinf)
+        elif k <= nr:
+            wts[k] = math.log(tg.ratios[k - 1] - 1.0) + math.log(vinf)
+        else:
+            wts[k] = math.log(tg.dvs[k - 1 - nr])
+    order = np.argsort(-wts)
     v_cur = vs
+    w_cur = math.log(vs - vinf) if vs > vinf else -math.inf
     t_cur = 0.0
     for kk in range(nt):
         k = order[kk]
@@ -274,10 +299,16 @@ def _case_targets(tab, mp, x0, vinf, vs, vb, trapped, tg, tau, quad, i, out):
             out.T[k, i] = 0.0
         elif trapped and (vt <= vb or vs <= vb):
             out.T[k, i] = math.inf
-        else:
+        elif trapped:
             if vt < v_cur:
                 t_cur += _time(tab, mp, x0, vb, vt, v_cur, quad)
                 v_cur = vt
+            out.T[k, i] = tau * t_cur
+        else:
+            if wts[k] < w_cur:
+                t_cur += _time_w(tab, mp, x0, vb, vt, wts[k], v_cur, w_cur, quad)
+                v_cur = vt
+                w_cur = wts[k]
             out.T[k, i] = tau * t_cur
 
 
@@ -317,7 +348,8 @@ def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
         out.status[i] = ST_OUT
         return
     vinf, vs, vb, trapped = _case_state(tab, mp, x0, vs_in, tau, h, i, out)
-    if not trapped and not (vs > vinf):
+    # a start at or below ū∞ (trapped rows too), compared as reported (SI): u_start is vs h
+    if not (vs * h > vinf * h):
         _nan_row(out, i, x0)
         out.u_inf[i] = vinf * h
         out.status[i] = ST_BELOW

@@ -15,7 +15,7 @@ from .._core.validate import align_inputs, as_float_array, check_positive
 from .._core.vocab import DEFAULT_THEORY, REFERENCES, column_name
 from ..tables import Tables
 from . import _kernels as qk
-from ._fastpath import fast_kernel, history_kernel, quad_kernel
+from ._fastpath import fast_kernel, history_kernel, one_case_primitive, quad_kernel, row_targets
 from .model import DEFAULT_P_START, squeeze_model
 from .primitive import fast_limit
 from .reduced import flat_separation
@@ -132,7 +132,8 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad):
     if method == "quad":
         quad_kernel(model.tab, model.mp, cs, model.h_rms, tg, quad, out)
     else:
-        fast_kernel(model.tab, model.mp, model.primitive(), fast_limit(model), cs,
+        pr = model.primitive()
+        fast_kernel(model.tab, model.mp, pr, row_targets(pr, tg.ratios), fast_limit(model), cs,
                     model.h_rms, tg, quad, out)
     return out
 
@@ -248,7 +249,7 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=No
 def frame(model, cs, out, ratios, du, times, order, names, method):
     """The result DataFrame of :func:`squeeze_out` from the kernel outputs."""
     status = out.status
-    trapped = status == qk.ST_TRAPPED
+    trapped = qk.trapped_mask(status, out.u_trap)
     x_perc = model.x_perc
     perc = (trapped & (np.log(cs.p0 / cs.E) >= x_perc) if np.isfinite(x_perc)
             else np.zeros(status.size, dtype=bool))
@@ -313,7 +314,7 @@ def squeeze_history(tables, p0, E_star, R, eta, theory=DEFAULT_THEORY, t=None, u
     u = np.empty(t.size)
     if row["status"] == "ok" and x0 <= fast_limit(model):
         vs = math.nan if u_start is None else float(u_start) / h
-        history_kernel(model.primitive(), x0, vs, float(row["tau0"]), h, t, u)
+        history_kernel(*one_case_primitive(model.primitive(), x0), vs, float(row["tau0"]), h, t, u)
     else:
         order = np.argsort(t, kind="stable")
         quad, _ = _check_method("quad", quad_order, quad_width, sigma_trap)

@@ -215,25 +215,38 @@ def z_of_t(pr, st, vinf, T):
             fp = -S - (h0 - S) * math.exp(z - pr.z0)
             dzn = f / fp
             z -= dzn
-            if abs(dzn) <= 1e-15 * (1.0 + abs(z)):
+            if abs(dzn) <= 1e-13 * (1.0 + abs(z)):  # beyond the round-off of T: would stall
                 break
         return z - lk
     lt = math.log(T)
     # bracket: combined ln T at the nodes decreases with k
     lo = 0
     hi = pr.nz - 1
+    y_lo = row_value_2(pr.C, st, lo)
+    y_hi = row_value_2(pr.C, st, hi)
     while hi - lo > 1:
         mid = (lo + hi) // 2
-        if row_value_2(pr.C, st, mid) >= lt:
+        y_mid = row_value_2(pr.C, st, mid)
+        if y_mid >= lt:
             lo = mid
+            y_lo = y_mid
         else:
             hi = mid
+            y_hi = y_mid
     cf = _cell(pr, st, lo)
     a, b = 0.0, 1.0
-    t = 0.5
-    for _ in range(60):  # safeguarded Newton on the combined quintic
+    # start from the chord, then safeguarded Newton on the combined quintic; |Δt| <= 1e-13
+    # (Δz <= 2.5e-14) ends it: quadratic convergence makes the last step's error far smaller,
+    # and asking for less than the round-off of ln T (~1e-15 |ln T| / |d ln T/dt|) would
+    # only stall the iteration in bisection
+    t = (y_lo - lt) / (y_lo - y_hi) if y_lo > y_hi else 0.5
+    if not (0.0 < t < 1.0):
+        t = 0.5
+    for _ in range(60):
         val, der = _quintic(t, pr.dz, cf)
         f = val - lt
+        if f == 0.0:
+            break
         if f > 0.0:
             a = t
         else:
@@ -241,7 +254,7 @@ def z_of_t(pr, st, vinf, T):
         tn = t - f / (der * pr.dz) if der != 0.0 else 0.5 * (a + b)
         if not (a < tn < b):
             tn = 0.5 * (a + b)
-        if abs(tn - t) <= 1e-15 or b - a <= 1e-15:
+        if abs(tn - t) <= 1e-13 or b - a <= 1e-13:
             t = tn
             break
         t = tn

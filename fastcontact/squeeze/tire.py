@@ -49,7 +49,7 @@ from . import _kernels as qk
 from .api import _check_method, attrs, run_cases, squeeze_history, squeeze_out, status_column
 from .model import squeeze_model
 from .primitive import fast_limit
-from ._fastpath import history_kernel
+from ._fastpath import history_kernel, one_case_primitive
 from .reduced import inertia_time_constant
 
 __all__ = ["tire_footprint", "tire_history", "tire_columns", "profile_factors",
@@ -123,12 +123,13 @@ def profile_factors(profile):
     return 1.0, float(f.max())
 
 
-def _inputs(p0, E_star, R, eta, footprint_length, speed, rho, u_start):
+def _inputs(p0, E_star, R, eta, footprint_length, speed, rho, u_start, alpha_pv=0.0):
     arrs = dict(p0=check_positive("p0", p0, "[Pa]"), E_star=check_positive("E_star", E_star, "[Pa]"),
                 R=check_positive("R", R, "[m]"), eta=check_positive("eta", eta, "[Pa·s]"),
                 footprint_length=check_positive("footprint_length", footprint_length, "[m]"),
                 speed=check_positive("speed", speed, "[m/s]"),
-                rho=check_positive("rho", rho, "[kg/m^3]"))
+                rho=check_positive("rho", rho, "[kg/m^3]"),
+                alpha_pv=check_positive("alpha_pv", alpha_pv, "[1/Pa]", allow_zero=True))
     if u_start is not None:
         arrs["u_start"] = check_positive("u_start", u_start, "[m]")
     try:
@@ -151,7 +152,8 @@ def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
     sq = run_cases(model, cs, r, np.array([du_complete / model.h_rms]),
                    np.ascontiguousarray(t_fp[None, :]), method, quad)
     out.update(u_inf=sq.u_inf, u_start=sq.u_start, t_du=sq.T[1 + r.size], t_star=sq.T[0],
-               trapped=sq.status == qk.ST_TRAPPED, u_trap=sq.u_trap, fluid_load_fraction=sq.flf,
+               trapped=qk.trapped_mask(sq.status, sq.u_trap), u_trap=sq.u_trap,
+               fluid_load_fraction=sq.flf,
                out_of_table=sq.status == qk.ST_OUT, status=status_column(sq.status))
     for k, name in enumerate(_ratio_names(ratios)):
         out[name] = sq.T[1 + k]
@@ -166,7 +168,7 @@ def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
 def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1000.0,
                    theory=DEFAULT_THEORY, pressure_profile="uniform", pressure_model="mean",
                    u_start=PAPER_TIRE["u_start"], du_complete=1e-6, ratios=(1.1, 1.01, 1.001),
-                   columns=None, method=None):
+                   columns=None, method=None, alpha_pv=0.0):
     """Squeeze-out of a tread block during its passage through the footprint (Sec. 5).
 
     Every case (its own pressure, speed and footprint length) costs a few interpolations of
@@ -206,6 +208,12 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
         Columns wanted (default all of :func:`tire_columns`).
     method : {"fast", "quad"} or None
         Squeeze-out engine (None: :func:`squeeze_method` of the case count).
+    alpha_pv : array_like, default 0.0
+        Barus pressure–viscosity coefficient α [1/Pa] >= 0, η = η0 exp(α p_f) (issue 14).
+        Rows with α > 0 run :mod:`fastcontact.squeeze.tire_piezo` (exact reduced-pressure
+        rate factor, quadrature in ln(ū − ū∞); ``method`` does not apply to them; status
+        "piezo_limit" with NaN results where α(p_eval − p_cont(ū(0))) >= 1); rows with
+        α = 0 are the base engine's, bit for bit.
 
     Returns
     -------
@@ -228,7 +236,7 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
     if unknown:
         raise ValueError(f"columns = {unknown!r} is invalid: tire columns are {allc}")
     want = set(columns)
-    b = _inputs(p0, E_star, R, eta, footprint_length, speed, rho, u_start)
+    b = _inputs(p0, E_star, R, eta, footprint_length, speed, rho, u_start, alpha_pv)
     n = b["p0"].size
     p_peak = b["p0"] * peak
     p_eval = b["p0"] if pressure_model == "mean" else p_peak
@@ -239,8 +247,15 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
     if want - {"p_eval", "p_peak", "t_footprint", "tau_inertia"}:
         if method is None:
             method = squeeze_method(n)
-        model = _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method,
-                                 out)
+        if np.any(b["alpha_pv"] > 0.0):                    # issue 14: Barus fluid
+            from .tire_piezo import barus_tire_columns
+            model = barus_tire_columns(
+                tables, b, p_eval, t_fp, theory, ratios, _ratio_names(ratios), du_complete,
+                b["alpha_pv"], out, lambda tb, bb, pe, tf, o: _squeeze_columns(
+                    tb, bb, pe, tf, theory, ratios, du_complete, method, o))
+        else:
+            model = _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete,
+                                     method, out)
         u_used = out["u_start"]
     if want & {"tau_inertia", "t_star_inertia"}:
         tau = np.asarray(inertia_time_constant(2.0 * b["R"], b["rho"], p_eval), float) * np.ones(n)
@@ -286,7 +301,8 @@ def tire_history(tables, *, p0, E_star, R, eta, t, theory=DEFAULT_THEORY,
     if row["status"] == "ok" and x0 <= fast_limit(model):
         u = np.empty(t.size)
         vs = math.nan if u_start is None else float(u_start) / model.h_rms
-        history_kernel(model.primitive(), x0, vs, float(row["tau0"]), model.h_rms, t, u)
+        history_kernel(*one_case_primitive(model.primitive(), x0), vs, float(row["tau0"]),
+                       model.h_rms, t, u)
     else:
         u = squeeze_history(tables, p0, E_star, R, eta, theory, t, u_start=u_start)["u"].to_numpy()
     df = pd.DataFrame({"t": t, "u": u, "du": u - u_inf, "u_inf": np.full(t.size, u_inf)},

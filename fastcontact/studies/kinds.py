@@ -19,6 +19,7 @@ from ..squeeze import columns as squeeze_engine_columns
 from ..squeeze import squeeze_out
 from ..squeeze.api import units_of as squeeze_units
 from ..squeeze.tire import squeeze_method, tire_columns, tire_footprint
+from . import extensions as _ext
 
 __all__ = ["StudyKind", "KINDS", "BOOL_COLUMNS", "SQUEEZE_TAIL", "SEAL_COLUMNS",
            "SEAL_HERTZ_COLUMNS", "squeeze_columns", "available_columns", "column_units"]
@@ -125,9 +126,16 @@ def squeeze_columns(ratios, du, times) -> list:
 def _squeeze_infer(axes, fixed, given, problems):
     if _missing(axes, given, "geometry", "R"):
         problems.append("geometry.R is missing: the block radius, e.g. R = \"2 cm\"")
+    _ext.check("squeeze", axes, fixed, given, problems)
 
 
 def _squeeze_evaluate(tables, rows, theory, fixed, columns, scale=1.0):
+    if "alpha_pv" in rows:                                  # issue 14: Barus fluid
+        return _ext.squeeze_evaluate(tables, rows, theory, fixed, columns, scale, _squeeze_base)
+    return _squeeze_base(tables, rows, theory, fixed, columns, scale)
+
+
+def _squeeze_base(tables, rows, theory, fixed, columns, scale=1.0):
     ratios = [r for r in fixed["ratios"] if column_name("t_ratio", r) in columns]
     du = [d for d in fixed["du"] if column_name("t_du", d) in columns]
     times = [t for t in fixed["times"] if column_name("u_at", t) in columns]
@@ -167,7 +175,8 @@ def _tire_evaluate(tables, rows, theory, fixed, columns, scale=1.0):
                         pressure_profile=fixed["pressure_profile"],
                         pressure_model=fixed["pressure_model"], u_start=_col(rows, "u_start"),
                         du_complete=fixed["du_complete"], ratios=fixed["ratios"],
-                        columns=list(dict.fromkeys(list(columns) + ["out_of_table"])))
+                        columns=list(dict.fromkeys(list(columns) + ["out_of_table"])),
+                        **_ext.tire_kwargs(rows))
     out = {c: df[c].to_numpy() for c in columns}
     out["_error"] = _out_of_table_errors(tables, rows, df["out_of_table"].to_numpy(bool))
     return out
@@ -175,6 +184,7 @@ def _tire_evaluate(tables, rows, theory, fixed, columns, scale=1.0):
 
 # =========================================================================== seal
 def _seal_infer(axes, fixed, given, problems):
+    _ext.check("seal", axes, fixed, given, problems)
     hertz = fixed.get("profile") == "hertz"
     if _missing(axes, given, "study", "dp"):
         problems.append("study.dp is missing (seal study): the pressure difference")
@@ -205,6 +215,10 @@ def _seal_columns(fixed):
 
 
 def _seal_evaluate(tables, rows, theory, fixed, columns, scale=1.0):
+    return _ext.seal_evaluate(tables, rows, theory, fixed, columns, _seal_base)
+
+
+def _seal_base(tables, rows, theory, fixed, columns, **ext):
     kw = dict(dp=_col(rows, "dp"), L_y=_col(rows, "L_y"), E_star=_col(rows, "E_star"),
               eta=_col(rows, "eta"), theory=theory, alpha_cj=_col(rows, "alpha_cj"),
               p_b=_col(rows, "p_b"), profile=fixed.get("profile", "uniform"))
@@ -212,10 +226,10 @@ def _seal_evaluate(tables, rows, theory, fixed, columns, scale=1.0):
         kw.update(R=_col(rows, "R"), f_N=_col(rows, "f_N"))
     else:
         kw.update(p0=_col(rows, "p0"), L=_col(rows, "L"))
-    df = seal_leak(tables, **kw).reset_index(drop=True)
+    df = seal_leak(tables, **kw, **ext).reset_index(drop=True)
     if len(df) != len(rows):
         raise RuntimeError(f"seal_leak returned {len(df)} rows for {len(rows)} cases")
-    out = {c: df[c].to_numpy() for c in columns}
+    out = {c: df[c].to_numpy() if c in df else np.full(len(df), np.nan) for c in columns}
     err = np.full(len(rows), "", dtype=object)
     if "converged" in df:
         err[~df["converged"].to_numpy(bool)] = "seal solver did not converge (see error_estimate)"
@@ -240,6 +254,9 @@ KINDS = {
         "seal", {"theory": DEFAULT_THEORY, "p_b": 0.0, "profile": "uniform",
                  "alpha_cj": 1.0},
         ("leak_rate", "profiles"), _seal_infer, _seal_columns, _seal_evaluate),
+    "asperity": StudyKind(                                  # issue 14: asperity cascade
+        "asperity", dict(_ext.ASPERITY_DEFAULTS), (), _ext.asperity_infer,
+        _ext.asperity_columns, _ext.asperity_evaluate),
 }
 
 

@@ -304,6 +304,9 @@ def _calibration_options(kind, fixed, given_opts, base, problems):
 def _table_options(kind, fixed, given, base, problems):
     """(options with defaults, options given, cache folder) of ``[tables]``."""
     given_opts = {k: fixed.pop(k) for k in ("gamma", "a_perc", "alpha_cj") if k in fixed}
+    aniso = fixed.pop("anisotropy", 1.0)
+    if aniso is not None and aniso != 1.0:                  # issue 14: anisotropic tables
+        given_opts["anisotropy"] = aniso
     _calibration_options(kind, fixed, given_opts, base, problems)
     if kind == "seal" and ("tables", "alpha_cj") in given:
         problems.append("tables.alpha_cj: for a seal study give the junction factor as "

@@ -11,7 +11,7 @@ __all__ = ["STUDY_KINDS", "Key", "SCHEMA", "SURFACE_KEYS", "TOP_KEYS", "AXIS_KEY
            "SELF_AFFINE_KEYS", "MAX_CASES", "did_you_mean", "input_units", "parse_scalar",
            "check_bounds", "try_parse"]
 
-STUDY_KINDS = ("squeeze", "tire", "seal")
+STUDY_KINDS = ("squeeze", "tire", "seal", "asperity")
 #: largest study (cases x surfaces) a scene may ask for unless ``[outputs] max_cases`` or
 #: ``fastcontact run --max-cases`` raises it; counted before anything is allocated
 MAX_CASES = 20_000_000
@@ -77,6 +77,25 @@ SCHEMA = {
         "f_N": _K("num", "force_per_length", axis=True, studies=("seal",), lo=0, lo_open=True),
         "alpha_cj": _K("num", axis=True, studies=("seal",), lo=0, lo_open=True,
                        doc="critical-junction factor on u1 (σ scales with α_cj³)"),
+        # issue 14 extensions (a scene that does not name them computes nothing extra)
+        "alpha_pv": _K("num", "inverse_pressure", axis=True, studies=("squeeze", "tire", "seal"),
+                       lo=0, doc="pressure–viscosity coefficient α (Barus; Roelands: initial "
+                       "slope), η = η0 exp(α p_f)"),
+        "viscosity": _K("choice", studies=("seal",), choices=("barus", "roelands"),
+                        doc="pressure–viscosity law of alpha_pv"),
+        "roelands_z": _K("num", axis=True, studies=("seal",), lo=0,
+                         doc="Roelands pressure–viscosity index Z (default: from alpha_pv)"),
+        "roelands_p_r": _K("num", "pressure", studies=("seal",), lo=0, lo_open=True,
+                           doc="Roelands reference pressure (default 1/5.1e-9 Pa)"),
+        "roelands_eta_inf": _K("num", "viscosity", studies=("seal",), lo=0, lo_open=True,
+                               doc="Roelands limiting viscosity (default exp(-9.67) Pa s)"),
+        "direction": _K("choice", studies=("seal",), choices=("x", "y"),
+                        doc="flow along ('x') or across ('y') the long correlation length "
+                            "(tables.anisotropy)"),
+        "level_ratio": _K("num", studies=("asperity",), lo=1, lo_open=True,
+                          doc="ratio of successive magnification levels (asperity cascade)"),
+        "zeta_max": _K("num", studies=("asperity",), lo=1,
+                       doc="highest magnification level (default ζ1/10)"),
     },
     "material": {
         "E": _K("num", "pressure", axis=True, lo=0, lo_open=True),
@@ -103,6 +122,8 @@ SCHEMA = {
         "cache_dir": _K("str"),
         "calibration": _K("str", doc="calibration TOML file (fastcontact bem calibrate), "
                           "relative to the scene: sets gamma, a_perc, alpha_cj, emt_threshold"),
+        "anisotropy": _K("num", lo=1, doc="Peklenik number γ_T = ξ_x/ξ_y >= 1 of the tables "
+                         "(issue 14; 1 = isotropic; needs theory 'emt')"),
     },
     "outputs": {
         "columns": _K("strlist"),

@@ -74,7 +74,7 @@ def _table_surface(pre, name, sd, base, theories, topts_given, problems, label):
                         f"but the study needs {missing} (rebuild it with `fastcontact tables "
                         f"build --theories ...`, or use a psd/self-affine surface)")
     for k, val in topts_given.items():
-        have = meta.get("options", {}).get(k, 0.5 if k == "emt_threshold" else None)
+        have = meta.get("options", {}).get(k, {"emt_threshold": 0.5, "anisotropy": 1.0}.get(k))
         if have is not None and not math.isclose(have, val, rel_tol=1e-12):
             problems.append(f"{pre}.table = {v!r}: built with {k} = {have!r} but tables.{k} = {val!r}")
     expected = _expected_surface(pre, v, sd, path, problems)

@@ -11,7 +11,6 @@ import math
 import time
 
 import numpy as np
-from scipy.special import erf
 
 from .._core.validate import check_positive, check_range
 from .._core.vocab import THEORIES
@@ -298,6 +297,7 @@ def _assemble(psd, lnp, cols, theories, options):
     data = {"p_over_E": pbar, "u_over_h": cols["u"], "dlnu_dlnp": cols["dlnu"],
             "d2lnu_dlnp2": cols["d2lnu"]}
     G1 = 0.25 * math.pi * psd.cum3[-1]
+    from scipy.special import erf   # here: loading tables (the run path) needs no scipy.special
     data["area_fraction"] = erf(pbar / (2.0 * math.sqrt(G1)))
     perc_p = {}
     for th in theories:
@@ -323,7 +323,8 @@ def _assemble(psd, lnp, cols, theories, options):
 
 def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid=None, *,
                emt_tol=EMT_TOL, emt_almqvist=False, points_per_decade=None, tolerance=None,
-               refine=True, emt_threshold=0.5, calibration=None):
+               refine=True, emt_threshold=0.5, calibration=None, anisotropy=1.0,
+               anisotropy_form="self_consistent"):
     """Tabulate ū (A4), A (A1), u1(ζc) (A3), σ̄ (eq. 23) and φ_p of a surface on a grid of p̄ = p/E*.
 
     The base grid (uniform in ln p̄) is refined adaptively: every interval whose Hermite
@@ -365,6 +366,20 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
         a non-default value that differs from the calibration's raises ValueError. The
         constants, ``fitted`` and the calibration's ``provenance`` are recorded in
         ``info["calibration"]`` (covered by the file's metadata_sha256).
+    anisotropy : float
+        Peklenik/Tripp number γ_T = ξ_x/ξ_y >= 1 [-] of roughness stretched along x
+        (issue 14; docs/theory/extensions.md §3). 1 (default): isotropic tables, bit for bit
+        those built without the keyword. γ_T > 1 needs "emt" in ``theories``: the tables
+        then also hold σ̄_xx and σ̄_yy of the anisotropic Bruggeman medium
+        (:func:`fastcontact.flow.anisotropy.precompute_directional`, with this table's γ and
+        emt_threshold) on their nodes as the columns ``sigma_emt_x``, ``sigma_emt_y`` (and
+        their derivatives, φ_p, percolated); ``options`` records ``anisotropy`` and
+        ``anisotropy_form`` and ``info["directional"]`` the directional percolation
+        pressures and interpolation errors, all covered by the metadata digest. The plain
+        "emt" columns stay the isotropic medium of the angle-averaged C(q); read a direction
+        with ``Tables.conductivity(..., direction="x"|"y")`` or ``seal_leak(..., direction=)``.
+    anisotropy_form : {"self_consistent", "fixed"}
+        Depolarization form of the anisotropic medium (used only when γ_T != 1).
 
     Returns
     -------
@@ -385,6 +400,7 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
         gamma, alpha_cj, a_perc, emt_threshold = (const[k] for k in CALIBRATED)
     theories, options = _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist,
                                         emt_threshold)
+    aniso = _check_anisotropy(anisotropy, anisotropy_form, theories, options)
     gamma = options["gamma"]
     if grid is None:
         ppd = DEFAULT_POINTS_PER_DECADE if points_per_decade is None else points_per_decade
@@ -406,4 +422,33 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
             "build_seconds": time.perf_counter() - t_start}
     if cal_block is not None:
         info["calibration"] = cal_block
+    tables = Tables(psd, theories, options, grid, zg, data, info)
+    if aniso is None:
+        return tables
+    from ..flow.anisotropy import directional_columns, precompute_directional
+    d = precompute_directional(tables, aniso[0], form=aniso[1])
+    data = dict(data, **directional_columns(tables, d))
+    options = dict(options, anisotropy=aniso[0], anisotropy_form=aniso[1])
+    info["directional"] = dict(d.info)
+    info["build_seconds"] = time.perf_counter() - t_start
     return Tables(psd, theories, options, grid, zg, data, info)
+
+
+def _check_anisotropy(anisotropy, form, theories, options):
+    """None for isotropic tables (γ_T = 1), else (γ_T, form); ValueError naming the problem."""
+    g = float(check_range("anisotropy", anisotropy, 1.0, math.inf, "[-] (Peklenik number "
+                          "γ_T = ξ_x/ξ_y >= 1; put the long correlation length along x)",
+                          hi_open=True))
+    if form not in ("self_consistent", "fixed"):
+        raise ValueError(f"anisotropy_form = {form!r} is invalid: must be 'self_consistent' or "
+                         f"'fixed'")
+    if g == 1.0:
+        return None
+    if "emt" not in theories:
+        raise ValueError(f"anisotropy = {anisotropy!r} is invalid with theories = "
+                         f"{list(theories)}: the directional conductivities are those of the "
+                         f"effective medium, add 'emt' to theories")
+    if options["emt_almqvist"]:
+        raise ValueError(f"anisotropy = {anisotropy!r} is invalid with emt_almqvist = True: the "
+                         f"broadened P(u) is not implemented for the anisotropic medium")
+    return g, form

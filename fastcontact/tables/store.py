@@ -41,6 +41,12 @@ for _t in THEORIES:
     UNITS[f"d2lnsigma_{_t}"] = "1 (d2 ln sigma_bar / d ln p_bar2)"
     UNITS[f"phi_{_t}"] = "1 (pressure flow factor)"
     UNITS[f"percolated_{_t}"] = "bool"
+for _d in ("x", "y"):   # anisotropic tables (precompute(anisotropy=γ_T)): the emt directions
+    UNITS[f"sigma_emt_{_d}"] = f"1 (12 eta sigma_{_d}{_d} / h_rms^3)"
+    UNITS[f"dlnsigma_emt_{_d}"] = f"1 (d ln sigma_bar_{_d}{_d} / d ln p_bar)"
+    UNITS[f"d2lnsigma_emt_{_d}"] = f"1 (d2 ln sigma_bar_{_d}{_d} / d ln p_bar2)"
+    UNITS[f"phi_emt_{_d}"] = f"1 (pressure flow factor, {_d})"
+    UNITS[f"percolated_emt_{_d}"] = "bool"
 
 
 class TableRangeError(ValueError):
@@ -130,6 +136,25 @@ class Tables:
     def u_range(self):
         """(ū_min/h_rms, ū_max/h_rms): the tabulated range of separations [-]."""
         return float(self.data["u_over_h"][-1]), float(self.data["u_over_h"][0])
+
+    def percolation_area(self, theory):
+        """Area fraction A(ζ1)/A0 [-] at which ``theory``'s σ_eff vanishes (inf: never).
+
+        ``options["a_perc"]`` (critical junction), ``options.get("emt_threshold", 0.5)``
+        (effective medium; set by a calibration), inf ("average"). The one place engines
+        read the percolation threshold from.
+        """
+        self._need(theory)
+        if theory == "critical_junction":
+            return float(self.options.get("a_perc", 0.5))
+        if theory == "emt":
+            a = float(self.options.get("emt_threshold", 0.5))
+            d = self.options.get("direction")
+            if d is not None and self.options.get("anisotropy_form") == "fixed":
+                g = float(self.options["anisotropy"]) ** (1 if d == "x" else -1)
+                a = g * a / (1.0 - a + g * a)      # a directional view: odds scaled by γ_T^±1
+            return a
+        return math.inf
 
     def percolation_pressure(self, theory, E_star=1.0):
         """Contact pressure [Pa] at which ``theory``'s σ_eff vanishes (inf: never).
@@ -229,22 +254,50 @@ class Tables:
         eval_p(self.kernel_data(self.theories[0]), lnq, out)
         return (out.reshape(ub.shape) * E_star)[()]
 
-    def sigma_bar(self, p, E_star, theory):
-        """Reduced conductivity σ̄ = 12ησ_eff/h_rms³ [-] at contact pressure p [Pa] (eq. 23)."""
+    def _direction(self, direction, theory):
+        """The tables to read for ``direction`` (see :meth:`conductivity`)."""
+        from ..flow.anisotropy import tables_for_direction
+        return tables_for_direction(self, direction, theory)
+
+    def sigma_bar(self, p, E_star, theory, direction=None):
+        """Reduced conductivity σ̄ = 12ησ_eff/h_rms³ [-] at contact pressure p [Pa] (eq. 23);
+        ``direction`` as in :meth:`conductivity`."""
+        if direction is not None:
+            return self._direction(direction, theory).sigma_bar(p, E_star, theory)
         tab = self.kernel_data(theory)
         pb = self._pbar("p", p, E_star)
         out = np.empty(pb.size)
         eval_sigma(tab, np.ascontiguousarray(np.log(pb).ravel()), out)
         return out.reshape(pb.shape)[()]
 
-    def conductivity(self, p, E_star, eta, theory):
-        """σ_eff [m³/(Pa·s)] at contact pressure p [Pa], viscosity eta [Pa·s]; 0 where percolated."""
-        eta = check_positive("eta", eta, "[Pa·s]")
-        return self.sigma_bar(p, E_star, theory) * self.h_rms ** 3 / (12.0 * eta)
+    def conductivity(self, p, E_star, eta, theory, direction=None):
+        """σ_eff [m³/(Pa·s)] at contact pressure p [Pa], viscosity eta [Pa·s]; 0 where percolated.
 
-    def flow_factor(self, p, E_star, theory):
-        """Pressure flow factor φ_p = 12ησ_eff/ū³ [-] at contact pressure p [Pa]."""
-        return self.sigma_bar(p, E_star, theory) / (self.mean_separation(p, E_star) / self.h_rms) ** 3
+        Parameters
+        ----------
+        p : array_like
+            Contact pressure [Pa].
+        E_star : float or array_like
+            Effective modulus [Pa].
+        eta : float or array_like
+            Viscosity [Pa·s].
+        theory : {"average", "critical_junction", "emt"}
+            A theory these tables hold.
+        direction : {None, "x", "y"}
+            Flow direction for tables built with ``precompute(..., anisotropy=γ_T)``: σ_xx
+            (along the long correlation length) or σ_yy of the anisotropic effective medium
+            ("emt"; "average" carries no direction; "critical_junction" raises ValueError).
+            None: the isotropic columns. On isotropic tables (γ_T = 1) every direction gives
+            the result of None, bit for bit (σ_xx = σ_yy = σ for isotropic roughness).
+        """
+        eta = check_positive("eta", eta, "[Pa·s]")
+        return self.sigma_bar(p, E_star, theory, direction) * self.h_rms ** 3 / (12.0 * eta)
+
+    def flow_factor(self, p, E_star, theory, direction=None):
+        """Pressure flow factor φ_p = 12ησ_eff/ū³ [-] at contact pressure p [Pa] (``direction``
+        as in :meth:`conductivity`)."""
+        return self.sigma_bar(p, E_star, theory, direction) / (
+            self.mean_separation(p, E_star) / self.h_rms) ** 3
 
     def percolated(self, p, E_star, theory):
         """True where the contact has percolated for ``theory`` (σ_eff = 0, fluid trapped)."""

@@ -53,26 +53,30 @@ def _solve(W, sig, A1, lam):
                                     rtol=1e-14))
 
 
-def sigma_fixed(W, sig, A1, gamma):
-    """(σ̄_xx, σ̄_yy): ∫P (σ - s)/(γ s + σ) = 0 (x) and with 1/γ (y)."""
-    return _solve(W, sig, A1, gamma), _solve(W, sig, A1, 1.0 / gamma)
+def sigma_fixed(W, sig, A1, gamma, a_c=0.5):
+    """(σ̄_xx, σ̄_yy): ∫P (σ - s)/(k γ s + σ) = 0 (x) and with k/γ (y), k = A_c/(1 - A_c)
+    the odds of the isotropic medium's threshold A_c (docs/theory/extensions.md §3)."""
+    k = a_c / (1.0 - a_c)
+    return _solve(W, sig, A1, k * gamma), _solve(W, sig, A1, k / gamma)
 
 
-def sigma_self_consistent(W, sig, A1, gamma):
-    """(σ̄_xx, σ̄_yy) with λ = γ √(σ_yy/σ_xx) (brentq on ln λ)."""
-    if A1 >= 0.5:
+def sigma_self_consistent(W, sig, A1, gamma, a_c=0.5):
+    """(σ̄_xx, σ̄_yy) with λ_x = kΛ, λ_y = k/Λ, Λ = γ √(σ_yy/σ_xx) (brentq on ln Λ)."""
+    k = a_c / (1.0 - a_c)
+    if A1 >= a_c:
         return 0.0, 0.0
 
     def h(y):
         lam = math.exp(y)
-        sx, sy = _solve(W, sig, A1, lam), _solve(W, sig, A1, 1 / lam)
+        sx, sy = _solve(W, sig, A1, k * lam), _solve(W, sig, A1, k / lam)
         if sx == 0:
             return -50.0
         if sy == 0:
             return 50.0
         return y - math.log(gamma) - 0.5 * math.log(sy / sx)
 
-    lo = math.log(A1 / (1 - A1)) + 1e-7
-    y = optimize.brentq(h, lo, -lo, xtol=1e-13)
+    lo = math.log(A1 / (1 - A1) / k) + 1e-7
+    hi = math.log(k * (1 - A1) / A1) - 1e-7
+    y = optimize.brentq(h, lo, hi, xtol=1e-13)
     lam = math.exp(y)
-    return _solve(W, sig, A1, lam), _solve(W, sig, A1, 1 / lam)
+    return _solve(W, sig, A1, k * lam), _solve(W, sig, A1, k / lam)

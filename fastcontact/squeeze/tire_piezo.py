@@ -1,0 +1,195 @@
+"""Tire footprint with a pressure-dependent (Barus) viscosity: ``tire_footprint(alpha_pv=α)``.
+
+The tread block's squeeze-out (Lorenz & Persson 2010, Sec. 5, eqs. 17–19) with
+η(p_f) = η0 exp(α p_f), p_f the fluid pressure above the ambient. As in
+:mod:`fastcontact.squeeze.viscosity` the radial Reynolds flow reduces *exactly* through the
+reduced pressure ψ = (1 − e^{−αp})/α (σ0 depends on ū only, which is uniform under the
+block), so the squeeze rate is the constant-viscosity rate times g(α(p_eval − p_cont(ū))),
+g ∈ (1/2, 1] (docs/theory/extensions.md §2a). Every time column is the quadrature
+t = τ0 ∫ dũ/|dũ/dt̃| in w = ln(ū − ū∞) of that engine (Gauss–Legendre panels of width
+``QUAD_WIDTH`` in w), and ū at the footprint exit solves t(ū_exit) = t_footprint on the same
+quadrature: panels are summed downward from ū(0) until the exit time is passed, and the
+last panel's partial integral is inverted by safeguarded Newton (dt/dw = −integrand).
+
+Rows with α = 0 are evaluated by the base engine (bit for bit what ``tire_footprint``
+returns without ``alpha_pv``). Rows with α(p_eval − p_cont(ū(0))) >= 1 have no quasi-static
+solution (the rigid film cannot carry the load): status ``"piezo_limit"``, NaN results.
+
+References: C. Barus, Am. J. Sci. 45, 87 (1893), doi:10.2475/ajs.s3-45.266.87;
+B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+from numba import njit, prange
+
+from .api import STATUS_NAMES
+from .viscosity import DEFAULT_P_START, _lnv_of_lnp, _rate_factor, _scalars, _segment, _state
+
+__all__ = ["QUAD_ORDER", "QUAD_WIDTH", "STATUS", "barus_tire_columns"]
+
+QUAD_ORDER = 10
+QUAD_WIDTH = 1.0
+#: status names of the Barus tire rows (the base engine's, plus "piezo_limit")
+STATUS = tuple(STATUS_NAMES) + ("piezo_limit",)
+_OK, _TRAPPED, _OUT, _BELOW = (STATUS.index(s) for s in ("ok", "trapped", "out_of_table",
+                                                         "start_below_equilibrium"))
+_PIEZO = STATUS.index("piezo_limit")
+#: the exit search stops this far below ln(ū(0) − ū∞) (ū is then ū∞ to round-off)
+W_SPAN = 60.0
+
+
+@njit(cache=True)
+def _exit_w(tab, sc, x0, api, vinf, w0, target, glx, glw, width):
+    """w = ln(v − v∞) reached after reduced time ``target`` from w0 (-inf: beyond W_SPAN)."""
+    t = 0.0
+    w = w0
+    while w > w0 - W_SPAN:
+        wn = w - width
+        dt = _segment(tab, sc, x0, api, vinf, wn, w, glx, glw, width)
+        if t + dt >= target:
+            lo = wn
+            hi = w
+            y = 0.5 * (lo + hi)
+            for _ in range(100):
+                f = t + _segment(tab, sc, x0, api, vinf, y, w, glx, glw, width) - target
+                if f > 0.0:
+                    lo = y
+                else:
+                    hi = y
+                e = math.exp(y)
+                lnp, sig = _state(tab, sc[0], sc[1], sc[2], sc[3], sc[4], vinf + e)
+                dtdw = math.inf
+                if sig > 0.0:
+                    d = max(1e-300, -math.expm1(lnp - x0))
+                    g = _rate_factor(api * d) if api > 0.0 else 1.0
+                    dtdw = e / (sig * d * g)
+                yn = y + f / dtdw if dtdw < math.inf else 0.5 * (lo + hi)
+                if not (lo < yn < hi):
+                    yn = 0.5 * (lo + hi)
+                if abs(yn - y) <= 1e-14 * max(1.0, abs(y)) or hi - lo <= 1e-14 * max(1.0, abs(y)):
+                    return yn
+                y = yn
+            return y
+        t += dt
+        w = wn
+    return -math.inf
+
+
+@njit(parallel=True, cache=True)
+def _tire_kernel(tab, sc, p0, E, R, eta, alpha, us, t_fp, h, vt_ratio, vt_dv, glx, glw, width,
+                 T, u_exit, uinf, ustart, u_trap, flf, status):
+    """Per case: targets (ratios × v∞, then v∞ + dv) and ū at t_fp (SI outputs)."""
+    nr = vt_ratio.size
+    nt = T.shape[0]
+    for i in prange(p0.size):
+        x0 = math.log(p0[i] / E[i])
+        tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
+        for k in range(nt):
+            T[k, i] = math.nan
+        u_exit[i] = math.nan
+        u_trap[i] = math.nan
+        flf[i] = math.nan
+        uinf[i] = math.nan
+        ustart[i] = us[i]
+        if not (sc[0] <= x0 <= sc[5]):
+            status[i] = _OUT
+            continue
+        vinf = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0))
+        vs = us[i] / h
+        if vs != vs:
+            vs = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0 + math.log(DEFAULT_P_START)))
+        uinf[i] = vinf * h
+        ustart[i] = vs * h
+        trapped = x0 >= sc[4]
+        if trapped:
+            status[i] = _TRAPPED
+            u_trap[i] = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], sc[4])) * h
+            flf[i] = -math.expm1(sc[4] - x0)
+        else:
+            status[i] = _OK
+            flf[i] = 0.0
+        if not trapped and not (vs > vinf):
+            status[i] = _BELOW
+            continue
+        api = alpha[i] * p0[i]
+        lnps, _s = _state(tab, sc[0], sc[1], sc[2], sc[3], sc[4], vs)
+        if api * (-math.expm1(lnps - x0)) >= 1.0:
+            status[i] = _PIEZO
+            flf[i] = math.nan
+            u_trap[i] = math.nan
+            continue
+        vts = np.empty(nt)
+        for k in range(nt):
+            vts[k] = vt_ratio[k] * vinf if k < nr else vinf + vt_dv[k - nr]
+        order = np.argsort(-vts)
+        v_cur = vs
+        t_cur = 0.0
+        for kk in range(nt):
+            k = order[kk]
+            vt = vts[k]
+            if vt >= vs:
+                T[k, i] = 0.0
+                continue
+            if vt < v_cur:
+                t_cur += _segment(tab, sc, x0, api, vinf, math.log(vt - vinf),
+                                  math.log(v_cur - vinf), glx, glw, width)
+                v_cur = vt
+            T[k, i] = tau * t_cur
+        w0 = math.log(vs - vinf)
+        w = _exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, glx, glw, width)
+        u_exit[i] = (vinf + math.exp(w)) * h
+
+
+def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_complete,
+                       alpha, out, base_columns):
+    """Fill the squeeze-out columns of :func:`~fastcontact.squeeze.tire.tire_footprint` with
+    a Barus fluid (α = ``alpha`` [1/Pa] per row) into ``out``; rows with α = 0 go to
+    ``base_columns(tables, b_subset, p_eval_subset, t_fp_subset, out_subset)`` (the base
+    engine, bit for bit). Returns the base squeeze model (for the frame's attrs)."""
+    from .model import squeeze_model
+
+    n = p_eval.size
+    zero = alpha == 0.0
+    sel = np.flatnonzero(~zero)
+    m = sel.size
+    h = float(tables.h_rms)
+    r = np.asarray(ratios, dtype=np.float64)
+    vr = np.ascontiguousarray(np.concatenate(([1.01], r)))
+    dv = np.array([du_complete / h])
+    T = np.empty((vr.size + 1, m))
+    ue, ui, us, ut, fl = (np.empty(m) for _ in range(5))
+    st = np.empty(m, dtype=np.int8)
+    if m:
+        us_in = b["u_start"][sel] if "u_start" in b else np.full(m, np.nan)
+        x, w = np.polynomial.legendre.leggauss(QUAD_ORDER)
+        args = [np.ascontiguousarray(a, dtype=np.float64) for a in
+                (p_eval[sel], b["E_star"][sel], b["R"][sel], b["eta"][sel], alpha[sel], us_in,
+                 t_fp[sel])]
+        _tire_kernel(tables.kernel_data(theory), _scalars(tables, theory, None), *args, h, vr,
+                     dv, x, w, QUAD_WIDTH, T, ue, ui, us, ut, fl, st)
+    with np.errstate(invalid="ignore"):
+        piezo = {"u_inf": ui, "u_start": us, "t_du": T[1 + r.size], "t_star": T[0],
+                 "trapped": st == _TRAPPED, "u_trap": ut, "fluid_load_fraction": fl,
+                 "out_of_table": st == _OUT, "u_exit": ue, "du_exit": ue - ui,
+                 "squeeze_complete": (ue - ui) <= du_complete}
+    for k, name in enumerate(ratio_names):
+        piezo[name] = T[1 + k]
+    codes = np.empty(n, dtype=np.int8)
+    codes[sel] = st
+    base = {}
+    if np.any(zero):
+        base_columns(tables, {k: v[zero] for k, v in b.items()},
+                     np.ascontiguousarray(p_eval[zero]), np.ascontiguousarray(t_fp[zero]), base)
+        codes[zero] = np.asarray(base.pop("status").codes, dtype=np.int8)  # same first names
+    for key, val in piezo.items():
+        full = np.empty(n, dtype=val.dtype)
+        full[sel] = val
+        if base:
+            full[zero] = base[key]
+        out[key] = full
+    out["status"] = pd.Categorical.from_codes(codes, categories=list(STATUS))
+    return squeeze_model(tables, theory)

@@ -1,0 +1,122 @@
+"""Issue 14.2: Roelands viscosity in the seal engine (no reduced pressure: numerical solution).
+
+Reference: ``tests/reference/ext_roelands.py`` — Hamrock & Dowson's eq. 4.5 written out
+(constants 9.67 and 5.1e-9 1/Pa, or a larger c to make the law nonlinear at soft-seal
+pressures), the 1-D Reynolds equation with η(p) by solve_bvp (flat ring) and adaptive DOP853
+shooting (O-ring), in p itself.
+"""
+from __future__ import annotations
+
+import math
+import os
+import sys
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reference.ext_roelands import hertz_shoot, roelands, seal_bvp  # noqa: E402
+
+import fastcontact as fc  # noqa: E402
+from fastcontact.flow.piezoviscosity import (  # noqa: E402
+    ROELANDS_ETA_INF,
+    ROELANDS_P_R,
+    roelands_parameters,
+    viscosity_ratio,
+)
+from fastcontact.seal import seal_leak  # noqa: E402
+
+E_STAR, ETA, L_Y = 1e7, 1e-3, 0.1
+C, Z = 1e-5, 0.6            # p_r = 1e5 Pa: strongly nonlinear at these pressures
+
+
+@pytest.fixture(scope="module")
+def tables():
+    psd = fc.SelfAffinePSD(h_rms=5e-6, hurst=0.8, q0=1e4, q1=1e8)
+    return fc.precompute(psd, theories=("critical_junction", "emt"))
+
+
+def _sigma(tables, theory):
+    plo = tables.p_range[0] * E_STAR
+    return lambda pc: tables.conductivity(np.maximum(pc, plo * (1 + 1e-7)), E_STAR, ETA, theory)
+
+
+def test_law_is_hamrock_dowson():
+    p = np.array([0.0, 1e6, 1e8, 5e8, 1e9])
+    for eta0, z in ((0.05, 0.6), (1e-3, 0.4)):
+        ref = roelands(eta0, z)(p)
+        got = viscosity_ratio(p, "roelands", eta=eta0, roelands_z=z)
+        np.testing.assert_allclose(got, ref, rtol=1e-13)
+    # initial slope α0 = A Z / p_r: Z from alpha_pv reproduces it
+    A, Zs, pr = roelands_parameters(0.05, alpha_pv=2e-8)
+    assert pr == ROELANDS_P_R and abs(A - math.log(0.05 / ROELANDS_ETA_INF)) < 1e-14
+    eps = 1.0
+    slope = math.log(float(viscosity_ratio(eps, "roelands", eta=0.05, alpha_pv=2e-8))) / eps
+    assert abs(slope / 2e-8 - 1) < 1e-7
+    # below Barus at high pressure for Z < 1 (same initial slope)
+    assert viscosity_ratio(1e9, "roelands", eta=0.05, alpha_pv=2e-8) < \
+        viscosity_ratio(1e9, "barus", alpha_pv=2e-8)
+
+
+@pytest.mark.parametrize("theory", ["critical_junction", "emt"])
+def test_uniform_against_bvp(tables, theory):
+    p0, L = 5e4, 5e-3
+    for dp in (2e4, 4.5e4):
+        q, _ = seal_bvp(_sigma(tables, theory), lambda x: p0 + 0 * x, 0.0, L, dp, 0.0,
+                        roelands(ETA, Z, C))
+        got = seal_leak(tables, p0=p0, dp=dp, L=L, L_y=L_Y, E_star=E_STAR, eta=ETA,
+                        theory=theory, viscosity="roelands", roelands_z=Z, roelands_p_r=1 / C)
+        assert got.attrs["viscosity"] == "Roelands"
+        assert abs(got.Q[0] / (q * L_Y) - 1) < 1e-8
+        base = seal_leak(tables, p0=p0, dp=dp, L=L, L_y=L_Y, E_star=E_STAR, eta=ETA,
+                         theory=theory)
+        assert got.Q[0] < 0.9 * base.Q[0]                # the viscosity really matters
+
+
+@pytest.mark.parametrize("theory", ["critical_junction", "emt"])
+def test_hertz_against_shooting(tables, theory):
+    R, f_N = 1e-3, 3.0
+    a = math.sqrt(4 * f_N * R / (math.pi * E_STAR))
+    pH = 2 * f_N / (math.pi * a)
+    for dp in (3e4, 6e4):
+        ref = hertz_shoot(_sigma(tables, theory), pH, a, dp, 0.0, roelands(ETA, Z, C)) * L_Y
+        got = seal_leak(tables, profile="hertz", R=R, f_N=f_N, dp=dp, L_y=L_Y, E_star=E_STAR,
+                        eta=ETA, theory=theory, viscosity="roelands", roelands_z=Z,
+                        roelands_p_r=1 / C)
+        assert bool(got.converged[0]) and got.status[0] == "ok"
+        assert abs(got.Q[0] / ref - 1) < 2e-8
+
+
+def test_limits(tables):
+    kw = dict(p0=5e4, dp=np.array([1e4, 4e4]), L=5e-3, L_y=L_Y, E_star=E_STAR, eta=ETA,
+              theory="emt")
+    base = seal_leak(tables, **kw)
+    # Z = 0: constant viscosity (the η(p) solver reproduces the base engine)
+    z0 = seal_leak(tables, viscosity="roelands", roelands_z=0.0, **kw)
+    np.testing.assert_allclose(z0.Q, base.Q, rtol=1e-9)
+    # α p ≪ ln(η0/η_∞) and p ≪ p_r: Roelands with Z from α tends to Barus with that α; the
+    # difference is second order in α (ln η = αp + O((αp)²)) while the Barus effect is first
+    rel = []
+    for a in (2e-6, 5e-7):
+        bar = seal_leak(tables, alpha_pv=a, **kw)
+        roe = seal_leak(tables, alpha_pv=a, viscosity="roelands", **kw)
+        rel.append(np.abs(roe.Q / bar.Q - 1))
+        assert np.all(rel[-1] < 0.02 * np.abs(bar.Q / base.Q - 1))
+    assert np.all((rel[1] / rel[0] > 1 / 32) & (rel[1] / rel[0] < 1 / 8))   # ≈ (1/4)²
+    # Hertz, Z = 0
+    h = dict(profile="hertz", R=1e-3, f_N=3.0, dp=3e4, L_y=L_Y, E_star=E_STAR, eta=ETA,
+             theory="emt")
+    assert abs(seal_leak(tables, viscosity="roelands", roelands_z=0.0, **h).Q[0]
+               / seal_leak(tables, **h).Q[0] - 1) < 3e-8
+
+
+def test_bad_input(tables):
+    kw = dict(p0=5e4, dp=1e4, L=5e-3, L_y=L_Y, E_star=E_STAR, theory="emt")
+    with pytest.raises(ValueError, match="viscosity"):
+        seal_leak(tables, eta=ETA, viscosity="vogel", **kw)
+    with pytest.raises(ValueError, match="eta"):
+        seal_leak(tables, eta=5e-5, viscosity="roelands", roelands_z=0.6, **kw)
+    with pytest.raises(ValueError, match="roelands_z"):
+        seal_leak(tables, eta=ETA, viscosity="roelands", roelands_z=-0.1, **kw)
+    with pytest.raises(ValueError, match="roelands_p_r"):
+        seal_leak(tables, eta=ETA, viscosity="roelands", roelands_z=0.6, roelands_p_r=0.0, **kw)
