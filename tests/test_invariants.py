@@ -327,6 +327,7 @@ def _du_targets(tab):
 
 
 # =============================================================================== squeeze tests
+
 @pytest.mark.parametrize("theory", THEORIES)
 @SETTINGS
 @given(name=st.sampled_from(NAMES), seed=st.integers(0, 2 ** 32 - 1))
@@ -595,6 +596,11 @@ def monotone_violations(Q, increasing, rtol):
     return np.any(bad, axis=-1)
 
 
+def _near_lift_off(p_a, p0):
+    """Within 4 ulp of the lift-off equality p_a = p0 (either side: p_a = p_b + dp is rounded)."""
+    return np.abs(p_a - p0) <= 4 * np.finfo(float).eps * p0
+
+
 def seal_uniform_cases(tab, theory, rng, n):
     lo, hi = tab.p_range
     top = hi if theory == "average" else 1.5 * min(hi, tab.percolation_pressure(theory, 1.0))
@@ -616,14 +622,16 @@ def seal_uniform_cases(tab, theory, rng, n):
                 L_y=10 ** rng.uniform(-3, 1, n), eta=10 ** rng.uniform(-5, 2, n))
 
 
-@pytest.mark.xfail(reason="known open bug (issue 15): at dp/p0 ~ 1e-12 near full contact the uniform-ring Q misses the eq. (32) limit by more than 1e-6 and is not exactly additive in dp", strict=False)
 @pytest.mark.parametrize("theory", THEORIES)
 @SETTINGS
 @given(name=st.sampled_from(NAMES), seed=st.integers(0, 2 ** 32 - 1))
 def test_seal_uniform(theory, name, seed):
     """Uniform ring: Q >= 0, flags, Q non-increasing in p0 and non-decreasing in dp (within
     1e-9), additive over a split of dp (within 1e-7), the dp -> 0 limit (eq. 32) and exact
-    scaling in L_y/(eta L) and in (p0, dp, p_b, E*) -> k(p0, dp, p_b, E*), Q -> kQ."""
+    scaling in L_y/(eta L) and in (p0, dp, p_b, E*) -> k(p0, dp, p_b, E*), Q -> kQ.
+
+    Rows within 4 ulp of the lift-off equality p_b + dp = p0 are left out of the split and
+    the pressure scaling: rounding p_b + s dp or k p0 may carry them across it (Q = inf)."""
     tab = table(name)
     rng = np.random.default_rng(seed)
     n = 300
@@ -658,7 +666,8 @@ def test_seal_uniform(theory, name, seed):
     q2 = seal_leak(tab, theory=theory, **dict(kw, dp=(1 - s) * kw["dp"],
                                               p_b=kw["p_b"] + s * kw["dp"]))["Q"].to_numpy(float)
     Qt = df["Q"].to_numpy(float)
-    below = (kw["p_b"] + kw["dp"] < kw["p0"]) & ~df["percolated"].to_numpy(bool)
+    near = _near_lift_off(kw["p_b"] + kw["dp"], kw["p0"])
+    below = (kw["p_b"] + kw["dp"] < kw["p0"]) & ~df["percolated"].to_numpy(bool) & ~near
     with np.errstate(invalid="ignore"):
         v["Q_not_additive_in_dp"] = below & (np.abs(q1 + q2 - Qt) > 1e-7 * Qt)
     # dp -> 0: Q/dp = (L_y/L) sigma_eff(p0 - p_b)   (eq. 32), dp/(p0 - p_b) = 1e-12
@@ -682,7 +691,7 @@ def test_seal_uniform(theory, name, seed):
     sc2 = seal_leak(tab, theory=theory, **dict(kw, p0=kw["p0"] * kk, dp=kw["dp"] * kk,
                                                p_b=kw["p_b"] * kk, E_star=kw["E_star"] * kk)
                     )["Q"].to_numpy(float)
-    v["Q_scaling_pressures_E"] = _rel_mismatch(Qt * kk, sc2, 1e-9)
+    v["Q_scaling_pressures_E"] = ~near & _rel_mismatch(Qt * kk, sc2, 1e-9)
     report(v, df, dict(name=name, theory=theory, seed=seed))
 
 

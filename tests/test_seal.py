@@ -498,8 +498,9 @@ def test_uniform_invariants(tables, theory, lp0, r, rr, lpb):
     Q = df.Q.to_numpy()
     st_ = df.status.astype(str).to_numpy()
     assert np.all((Q >= 0) | np.isnan(Q))
-    assert np.all(np.isfinite(Q) | (st_ == "open") | (st_ == "above_table"))
-    assert np.all(np.isnan(Q) == (st_ == "above_table"))
+    nan_status = (st_ == "above_table") | (st_ == "near_percolation")
+    assert np.all(np.isfinite(Q) | (st_ == "open") | nan_status)
+    assert np.all(np.isnan(Q) == nan_status)
     assert np.all(np.isinf(Q) == (st_ == "open")) and bool(df.lift_off[3])
     for i in range(4):
         if df.percolated[i]:
@@ -555,3 +556,86 @@ def test_uniform_near_full_contact(tables, psd):
                                      eta=ETA, theory="average")
         df = _uniform(tables, "average", p0, 0.3 * p0)
         assert _rel(df.Q[0], ref) < 1e-7, (frac, df.Q[0], ref)
+
+
+# --------------------------------------------------------------------------- tiny widths, tail
+def test_reference_keeps_tiny_widths(psd):
+    """The reference integrates over the width itself: at dp/p0 = 1e-12 and 1e-10 it equals
+    the linear response (L_y/L) σ(p0 − dp/2) dp (one direct σ, exact to O(dp³))."""
+    for theory in ("average", "critical_junction"):
+        for r in (1e-12, 1e-10):
+            dp = r * P0
+            ref, est = uniform_reference(psd, p0=P0, dp=dp, L=L, L_y=L_Y, E_star=E_STAR,
+                                         eta=ETA, theory=theory)
+            lin = L_Y / L * dp * float(sigma_direct(psd, P0 - 0.5 * dp, E_STAR, ETA, theory)[0])
+            assert est < 1e-13 and _rel(ref, lin) < 1e-12, (theory, r, ref, lin)
+
+
+@pytest.mark.parametrize("theory", ["average", "critical_junction"])
+def test_uniform_tiny_dp_against_reference(tables, psd, theory):
+    df = _uniform(tables, theory, P0, np.array([1e-13, 1e-11, 1e-9, 1e-7]) * P0)
+    for i, dp in enumerate(df.dp):
+        ref, _ = uniform_reference(psd, p0=P0, dp=dp, L=L, L_y=L_Y, E_star=E_STAR, eta=ETA,
+                                   theory=theory)
+        assert df.status[i] == "ok" and _rel(df.Q[i], ref) < 1e-7, (dp, df.Q[i], ref)
+
+
+def _trusted_top(tables, theory):
+    """π (reduced) and σ̄ at the tables' last node with σ̄ above their floor (from the table
+    columns and metadata, not from fastcontact.seal)."""
+    sig = np.asarray(tables.data[f"sigma_{theory}"])
+    j = int(np.flatnonzero(sig > tables.info["sigma_floor"])[-1])
+    return float(tables.data["p_over_E"][j]), float(sig[j])
+
+
+@pytest.mark.parametrize("theory", ["critical_junction", "emt"])
+def test_uniform_near_percolation_flag(tables, theory):
+    """Rows whose contact pressure reaches past the tables' last node above the σ̄ floor are
+    flagged "near_percolation" with Q = NaN unless the bound 0 <= σ̄ <= σ̄(π_trust) on that
+    tail moves Q by at most 1e-9; otherwise Q is the midpoint of the bound (checked against
+    scipy quad of the tables' own σ̄ below π_trust)."""
+    pi_t, sig_t = _trusted_top(tables, theory)
+    pi_p = float(tables.percolation_pressure(theory, 1.0))
+    assert pi_t < pi_p
+    pref = L_Y * SURFACE["h_rms"] ** 3 * E_STAR / (12 * ETA * L)
+    # the bench case (p0 = 0.99 p_perc, dp = 1e-9 p0), the tail alone, just above/below π_trust
+    cases = [(0.99 * pi_p, 1e-9), (0.5 * (pi_t + pi_p), 0.3 * (pi_p - pi_t) / pi_p),
+             (pi_t * (1 + 1e-9), 0.5), (pi_t * (1 + 1e-9), 1e-3), (pi_t * (1 - 1e-9), 1e-9),
+             (0.999 * pi_p, 0.5), (0.999 * pi_p, 0.05), (0.999 * pi_p, 0.01)]
+    df = _uniform(tables, theory, np.array([c for c, _ in cases]) * E_STAR,
+                  np.array([c * r for c, r in cases]) * E_STAR)
+    assert not df.percolated.any() and not df.lift_off.any()
+    for i, (c, r) in enumerate(cases):
+        w = c * r
+        status, Q = df.status[i], df.Q[i]
+        if c <= pi_t:
+            assert status == "ok" and Q > 0
+            continue
+        over = c - pi_t
+        if w <= over:
+            assert status == "near_percolation" and np.isnan(Q), (c, r, status, Q)
+            continue
+        I_ver = _table_integral(tables, theory, pi_t, w - over)
+        U = sig_t * over
+        if U > 1e-9 * I_ver * 1.01:
+            assert status == "near_percolation" and np.isnan(Q), (c, r, U / I_ver)
+        elif U < 1e-9 * I_ver * 0.99:
+            assert status == "ok", (c, r, U / I_ver)
+            assert _rel(Q, pref * (I_ver + 0.5 * U)) < 1e-8, (c, r, Q, pref * I_ver)
+    assert (df.status == "near_percolation").sum() >= 3 and (df.status == "ok").sum() >= 3
+    # the average theory (σ̄ = (ū/h_rms)³, verified through ū) is trusted up to the table top
+    top = float(tables.p_range[1])
+    da = _uniform(tables, "average", np.array([0.999, 0.9]) * top * E_STAR,
+                  np.array([1e-9, 1e-9]) * top * E_STAR)
+    assert (da.status == "ok").all() and np.isfinite(da.Q).all()
+
+
+def test_uniform_flagged_rows_keep_the_batch(tables):
+    """A flagged row next to ordinary rows: only it is NaN, the others are unchanged."""
+    pi_p = float(tables.percolation_pressure("critical_junction", 1.0))
+    p0 = np.array([P0, 0.99 * pi_p * E_STAR, 2 * P0])
+    both = _uniform(tables, "critical_junction", p0, 1e-9 * p0)
+    alone = _uniform(tables, "critical_junction", p0[[0, 2]], 1e-9 * p0[[0, 2]])
+    assert list(both.status.astype(str)) == ["ok", "near_percolation", "ok"]
+    assert both.Q[0] == alone.Q[0] and both.Q[2] == alone.Q[1]
+

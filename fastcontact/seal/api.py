@@ -10,17 +10,19 @@ import pandas as pd
 
 from .._core.validate import align_inputs, check_positive
 from .._core.vocab import DEFAULT_THEORY
-from . import _panels, _sigma
+from . import _panels
 from ._inputs import (alpha_scale, check_tables, check_theory_for, common_inputs, forbid,
                       hertz_contact, profile_kind, require)
 from .context import RowsOut, panel_rule, seal_context, solver_options
+from ._uniform import leak_uniform
 from .hertz import VERIFY_TOL, table_W
 from .viscosity import seal_leak_piezo  # issue 14: Barus fluid (alpha_pv)
 
 __all__ = ["seal_leak", "columns", "STATUS", "UNITS", "REFERENCES", "EQUALITY_TOL"]
 
 #: row status names, indexed by the kernels' codes (``status`` column, a pandas Categorical)
-STATUS = ("ok", "lift_off", "open", "percolated", "above_table", "not_converged")
+STATUS = ("ok", "lift_off", "open", "percolated", "above_table", "not_converged",
+          "near_percolation")
 _ST_NOT_CONVERGED = STATUS.index("not_converged")
 
 #: unit of every result column ("" for flags and text)
@@ -80,20 +82,11 @@ def _status(codes):
 
 # =========================================================================== uniform
 def _leak_uniform(sc, theory, p0, L, com, alpha_cj):
-    """Flat ring: eq. (32) with the fluid feedback, q = (1/L) ∫_{p0−p_a}^{p0−p_b} σ_eff dp."""
-    p0 = check_positive("p0", p0, "[Pa]")
-    L = check_positive("L", L, "[m]")
-    shape, (p0, L, dp, L_y, E, eta, p_b, alpha) = _flat(
-        p0, L, com["dp"], com["L_y"], com["E_star"], com["eta"], com["p_b"], alpha_cj)
-    scale = np.ascontiguousarray(alpha_scale(sc, theory, alpha))
-    Q = np.empty(p0.size)
-    st = np.empty(p0.size, dtype=np.int8)
-    _sigma.uniform_rows(sc.tab, sc.rec, p0, L, dp, L_y, E, eta, p_b, scale, Q, st)
-    p_a = p_b + dp
-    return {"Q": Q, "lift_off": p_a >= p0, "percolated": st == _sigma.ST_PERCOLATED,
-            "status": _status(st), "p0": p0, "dp": dp, "p_a": p_a, "p_b": p_b, "L": L,
-            "L_y": L_y, "E_star": E, "eta": eta, "alpha_cj": alpha,
-            "open_inlet": np.where(p_a > p0, L, 0.0), "open_outlet": np.zeros_like(L)}, shape
+    """Flat ring: eq. (32) with the fluid feedback, q = (1/L) ∫_{p0−p_a}^{p0−p_b} σ_eff dp
+    (one parallel pass, :func:`._uniform.leak_uniform`)."""
+    cols, shape = leak_uniform(sc, theory, p0, L, com, alpha_cj)
+    cols["status"] = _status(cols["status"])
+    return cols, shape
 
 
 # =========================================================================== profiles
@@ -271,7 +264,9 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
         finite limit, beyond it Q = inf and ``status = "open"``); ``percolated`` (the contact
         percolates somewhere across the width: Q = 0); ``status`` (``"ok"``, ``"lift_off"``,
         ``"open"``, ``"percolated"``, ``"above_table"`` — contact pressure above the table,
-        Q = NaN —, ``"not_converged"`` — Q = NaN); the inputs; ``p_a`` [Pa];
+        Q = NaN —, ``"not_converged"`` — Q = NaN —, ``"near_percolation"`` — flat ring whose
+        contact pressure reaches the tables' unresolved tail, Q = NaN, see Notes); the
+        inputs; ``p_a`` [Pa];
         ``open_inlet``/``open_outlet`` [m]; non-uniform profiles also ``converged`` and
         ``error_estimate`` [-], Hertz ``a``, ``L`` [m], ``p_max`` [Pa]. ``df.attrs`` holds
         ``shape``, ``theory``, ``profile``, ``units`` and ``references``.
@@ -280,8 +275,15 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
     -----
     Flat ring: q = (1/L) ∫_{p0−p_a}^{p0−p_b} σ_eff(p) dp (eq. 33 with uniform p0), from a
     tabulated primitive whose short intervals are integrated directly — never a difference of
-    two large primitives; relative error <= 1e-7 against direct quadrature. Hertz and arrays:
-    eq. (33) on adaptive Gauss–Legendre panels by damped Newton.
+    two large primitives; relative error <= 1e-7 against direct quadrature. The tables verify
+    σ̄ only down to their floor (``tables.info["sigma_floor"]``, 1e-24): past the last node
+    above it, π_trust (just below the percolation pressure of "critical_junction" and "emt";
+    "average", σ̄ = (ū/h_rms)³, is verified through ū everywhere), σ̄ is an extrapolation
+    that can be off by tens of orders of magnitude. There Q uses the bound
+    0 <= σ̄ <= σ̄(π_trust) (σ̄ falls with p_cont) and reports the midpoint when the bound
+    moves Q by less than 1e-9 (``_sigma.TAIL_RTOL``); otherwise Q = NaN with status
+    ``"near_percolation"`` (e.g. dp << p0 with p0 − p_b just below the percolation
+    pressure). Hertz and arrays: eq. (33) on adaptive Gauss–Legendre panels by damped Newton.
 
     References
     ----------

@@ -8,25 +8,31 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 import weakref
 from typing import NamedTuple
 
 import numpy as np
 
 from ..flow.conductivity import check_theory
+from ..tables.build import SIGMA_FLOOR
 from . import _sigma
 
 __all__ = ["SealRecord", "SealContext", "seal_context", "PanelRule", "RowsOut", "panel_rule",
-           "solver_options", "SOLVER_DEFAULTS", "RETAB_H", "RETAB_TOL", "PRIM_H", "PRIM_GL"]
+           "solver_options", "SOLVER_DEFAULTS", "RETAB_H", "RETAB_TOL", "PRIM_H", "PRIM_GL",
+           "PRIM_DEPTH", "TAIL_SPLIT"]
 
 #: re-tabulation of ln σ̄ (uniform in ln π): spacing and per-cell verification tolerance
 RETAB_H = 1.0 / 64.0
 RETAB_TOL = 1e-9
-#: primitive of σ̄: node spacing in ln π and the Gauss–Legendre order of direct intervals
+#: primitive of σ̄: coarse node spacing in ln π and the Gauss–Legendre order of direct intervals
 PRIM_H = 1.0 / 64.0
 PRIM_GL = 6
-#: the steep part below percolation gets a primitive grid this many times finer
-FINE_SPLIT = 16
+#: cells below the trusted top whose quintic partials fail verification are bisected at most
+#: this many times (down to PRIM_H / 2**PRIM_DEPTH)
+PRIM_DEPTH = 10
+#: the unverified tail above the trusted top gets cells this many times finer than PRIM_H
+TAIL_SPLIT = 16
 
 
 class SealRecord(NamedTuple):
@@ -48,21 +54,27 @@ class SealRecord(NamedTuple):
         ln σ̄ and d ln σ̄/d ln π at the re-tabulation nodes.
     ok : ndarray of bool
         Re-tabulation cells verified against the table kernel.
-    st0, sh, nc, fh, t_top : float, float, int, float, float
-        Primitive grid: spacing sh from st0 up to node nc, spacing fh beyond (the steep
-        part below percolation); the last cell ends at t_top = min(t_hi, t_perc).
-    tn : ndarray
-        The primitive's nodes (last one t_top).
-    d1, d2 : ndarray
-        S' = σ̄ e^t and S'' at the primitive nodes.
-    cell : ndarray
-        ∫ σ̄ e^t dt over each primitive cell.
-    cell_ok : ndarray of bool
-        Cells whose quintic Hermite partial integrals are verified (else adaptive).
-    prefix, suffix : ndarray
-        Σ cell[:k] and Σ cell[k:] (compensated sums).
+    st0, sh : float
+        Start (= t_lo) and coarse spacing of the primitive's nodes; the bucket map ``B``
+        works on this spacing.
+    t_top : float
+        Last primitive node, min(t_hi, t_perc).
+    t_trust, pi_trust, sig_trust : float
+        ln π, π and σ̄ at the table's last node with σ̄ above its floor: beyond it, just below
+        percolation, σ̄ is not verified ("average": the table's top, σ̄ = (ū/h_rms)³ is
+        verified through ū everywhere).
+    P : ndarray, shape (n + 1, 8)
+        The primitive S(t) = ∫ σ̄ e^t dt per node k: t, S', S'', ∫ over cell k, prefix and
+        suffix sums (compensated), cell k verified (1.0), 1/width of cell k — columns
+        ``_sigma.P_*``.
+    B : ndarray of int64
+        B[c]: the cell holding st0 + c sh (bucket map of P's nodes).
     glx, glw : ndarray
         Gauss–Legendre rule of the direct intervals.
+    R, TQ, TQB, HS, G : ndarray
+        Packed copies for the flat-ring kernel: R = (ln σ̄, d ln σ̄/dt, cell verified) per
+        re-tabulation node; TQ = the table's (ln p̄, ln σ̄, d ln σ̄, d² ln σ̄) per node and
+        TQB its bucket map; HS the scalars (slots ``_sigma.H_*``); G = (glx, glw).
     h_rms : float
         rms roughness [m].
     p_perc, p_top : float
@@ -83,21 +95,46 @@ class SealRecord(NamedTuple):
     ok: np.ndarray
     st0: float
     sh: float
-    nc: int
-    fh: float
     t_top: float
-    tn: np.ndarray
-    d1: np.ndarray
-    d2: np.ndarray
-    cell: np.ndarray
-    cell_ok: np.ndarray
-    prefix: np.ndarray
-    suffix: np.ndarray
+    t_trust: float
+    pi_trust: float
+    sig_trust: float
+    P: np.ndarray
+    B: np.ndarray
     glx: np.ndarray
     glw: np.ndarray
+    R: np.ndarray
+    TQ: np.ndarray
+    TQB: np.ndarray
+    HS: np.ndarray
+    G: np.ndarray
     h_rms: float
     p_perc: float
     p_top: float
+
+
+def _trusted_top(tables, theory):
+    """(index, ln π, σ̄) of the table's last node up to which σ̄ is verified.
+
+    The build checks the σ̄ interpolant only between nodes whose σ̄ is above the tables' σ̄
+    floor; past the last such node (the super-exponential collapse before percolation) σ̄ is
+    unverified. "average" is σ̄ = (ū/h_rms)³, verified through ū at every node: its whole
+    table is trusted."""
+    sig = np.asarray(tables.data[f"sigma_{theory}"], dtype=np.float64)
+    if theory == "average":
+        j = sig.size - 1
+    else:
+        floor = float(tables.info.get("sigma_floor", SIGMA_FLOOR))
+        above = np.flatnonzero(sig > floor)
+        j = int(above[-1]) if above.size else 0
+    return j, float(np.log(tables.data["p_over_E"][j])), float(sig[j])
+
+
+def _bucket_map(tn, st0, sh):
+    nb = max(int(math.ceil((tn[-1] - st0) / sh)), 1)
+    edges = st0 + sh * np.arange(nb + 1)
+    B = np.searchsorted(tn, edges, side="right") - 1
+    return np.ascontiguousarray(np.clip(B, 0, tn.size - 2).astype(np.int64))
 
 
 class SealContext:
@@ -114,15 +151,21 @@ class SealContext:
         [m]
     p_perc, p_top : float
         Reduced percolation pressure (inf for "average") and table top.
+    pi_trust : float
+        Reduced contact pressure above which the tables' σ̄ is not verified.
     alpha_table, a_perc : float
         Junction factor and percolation area fraction the tables were built with.
     retab_worst : float
         Largest verified re-tabulation error of σ̄ (relative).
     retab_fallback_cells, prim_fallback_cells : int
-        Cells evaluated through the table kernel / integrated adaptively.
+        Re-tabulation cells evaluated through the table's quintic; primitive cells (below the
+        trusted top) integrated adaptively.
+    build_seconds : float
+        Time taken to build the record [s].
     """
 
     def __init__(self, tables, theory, prim_h=None, prim_gl=None):
+        t_start = time.perf_counter()
         tables._need(theory)
         self.theory = theory
         self.h_rms = float(tables.h_rms)
@@ -139,44 +182,56 @@ class SealContext:
         u_lo = float(np.ravel(tables.mean_separation(np.array([lo]), 1.0))[0]) / self.h_rms
         c_u = float(tables.info["asymptote_u0_over_h"])
         t_top = min(t_hi, t_perc)
+        _, t_trust, sig_trust = _trusted_top(tables, theory)
+        t_trust = min(t_trust, t_top)
+        self.pi_trust = math.exp(t_trust)
         nret = int(math.floor((t_top - t_lo) / RETAB_H)) + 1
         lns, dlns = _sigma.retabulate(self.tab, t_lo, RETAB_H, nret)
         sh = PRIM_H if prim_h is None else float(prim_h)
         glx, glw = np.polynomial.legendre.leggauss(PRIM_GL if prim_gl is None else int(prim_gl))
-        empty = np.zeros(1)
+        P0 = np.zeros((2, _sigma.P_COLS))
         rec = SealRecord(t_lo, t_hi, t_perc, float(f[0]), float(b1), u_lo, c_u, t_lo, RETAB_H,
-                         lns, dlns, np.ones(nret - 1, dtype=np.bool_), t_lo, sh, 0, sh, t_top,
-                         empty, empty, empty, empty, np.zeros(1, dtype=np.bool_), empty, empty,
-                         np.ascontiguousarray(glx), np.ascontiguousarray(glw), self.h_rms,
+                         lns, dlns, np.ones(nret - 1, dtype=np.bool_), t_lo, sh, t_top,
+                         t_trust, self.pi_trust, sig_trust, P0, np.zeros(2, dtype=np.int64),
+                         np.ascontiguousarray(glx), np.ascontiguousarray(glw), P0, P0,
+                         np.zeros(2, dtype=np.int64), np.zeros(_sigma.H_SIZE), P0, self.h_rms,
                          p_perc, float(hi))
         ok, worst = _sigma.verify_cells(self.tab, rec, RETAB_TOL)
         rec = rec._replace(ok=ok)
-        # coarse nodes, then FINE_SPLIT times finer from two cells before the first cell whose
-        # Hermite fails verification (the steep fall of σ̄ towards percolation / full contact)
-        nS = int(math.floor((t_top - t_lo) / sh))
-        tn = np.append(t_lo + sh * np.arange(nS + 1), t_top) if t_lo + nS * sh < t_top else \
-            t_lo + sh * np.arange(nS + 1)
-        prim = _sigma.build_primitive(self.tab, rec, tn)
-        bad = np.flatnonzero(~prim[3][1:]) + 1     # cell 0 touches the asymptote's C¹ join
-        nc = tn.size - 1
-        if bad.size:
-            nc = max(int(bad[0]) - 2, 0)
-            fh = sh / FINE_SPLIT
-            nf = int(math.floor((t_top - tn[nc]) / fh))
-            fine = tn[nc] + fh * np.arange(1, nf + 1)
-            fine = fine[fine < t_top]
-            tn = np.concatenate((tn[:nc + 1], fine, [t_top]))
-            rec = rec._replace(nc=nc, fh=fh)
-            prim = _sigma.build_primitive(self.tab, rec, tn)
-        d1, d2, cell, cell_ok, prefix, suffix = prim
-        self.rec = rec._replace(tn=tn, d1=d1, d2=d2, cell=cell, cell_ok=cell_ok, prefix=prefix,
-                                suffix=suffix)
+        # nodes: spacing sh up to the trusted top (cells bisected until verified), then the
+        # unverified tail up to t_top at sh / TAIL_SPLIT (adaptive where unverified)
+        nS = int(math.floor((t_trust - t_lo) / sh * (1.0 - 1e-12)))
+        tn = np.append(t_lo + sh * np.arange(nS + 1), t_trust)
+        if tn[-2] >= tn[-1] - 1e-3 * sh and tn.size > 2:
+            tn = np.delete(tn, -2)
+        n_ver = tn.size - 1
+        if t_top > t_trust:
+            fh = sh / TAIL_SPLIT
+            tail = t_trust + fh * np.arange(1, int(math.ceil((t_top - t_trust) / fh)) + 1)
+            tn = np.concatenate((tn, tail[tail < t_top - 1e-3 * fh], [t_top]))
+        P = _sigma.build_primitive(self.tab, rec, np.ascontiguousarray(tn), n_ver, PRIM_DEPTH)
+        tab = self.tab
+        HS = np.zeros(_sigma.H_SIZE)
+        HS[[_sigma.H_RT0, _sigma.H_RH, _sigma.H_TLO, _sigma.H_B0, _sigma.H_B1, _sigma.H_TPERC,
+            _sigma.H_ST0, _sigma.H_SH, _sigma.H_TQLO, _sigma.H_TQDZ, _sigma.H_NOPEN,
+            _sigma.H_LNPPERC, _sigma.H_ISH]] = (rec.rt0, rec.rh, t_lo, rec.b0, rec.b1, t_perc,
+                                                t_lo, sh, tab.bp_lo, tab.bp_dz, tab.n_open,
+                                                tab.lnp_perc, 1.0 / sh)
+        self.rec = rec._replace(
+            P=P, B=_bucket_map(np.ascontiguousarray(P[:, _sigma.P_T]), t_lo, sh),
+            R=np.ascontiguousarray(np.column_stack((lns, dlns, np.append(ok, False)))),
+            TQ=np.ascontiguousarray(np.column_stack((tab.lnp, tab.lnsig, tab.dlnsig,
+                                                     tab.d2lnsig))),
+            TQB=np.ascontiguousarray(tab.bp_idx, dtype=np.int64), HS=HS,
+            G=np.ascontiguousarray(np.vstack((glx, glw))))
+        below = P[:-1, _sigma.P_T] < t_trust
         self.retab_worst = float(worst)
         self.retab_fallback_cells = int((~ok).sum())
-        self.prim_fallback_cells = int((~cell_ok).sum())
+        self.prim_fallback_cells = int((P[:-1, _sigma.P_OK][below] == 0.0).sum())
         self.alpha_table = float(tables.options.get("alpha_cj", 1.0))
         self.a_perc = float(tables.options.get("a_perc", 0.5))
         self.hertz = None            # the O-ring table (fastcontact.seal.hertz), built lazily
+        self.build_seconds = time.perf_counter() - t_start
 
 
 _CONTEXTS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()

@@ -9,9 +9,11 @@ Uniform ring (eq. 32 with the fluid feedback, eq. 33 for uniform p0 in closed fo
     Q = (L_y / L) ∫_{p0 − p_a}^{p0 − p_b} σ_eff(p) dp
 
 integrated in t = ln p by composite Gauss–Legendre (16 nodes per panel, panels of width
-<= 0.25 in t, σ_eff evaluated directly at every node in one vectorised call); the lower limit
-p → 0 (lift-off equality) is cut at t = ln(p0 − p_b) − 46 (σ grows like ln³, the neglected
-part is < e^-40 relative). Error estimate: the same with panels halved.
+<= 0.25 in t, σ_eff evaluated directly at every node in one vectorised call), over the
+offset below t_b = ln(p0 − p_b) whose width −ln(1 − dp/(p0 − p_b)) is formed from dp itself
+(no cancellation however small dp/p0); the lower limit p → 0 (lift-off equality) is cut at
+t = ln(p0 − p_b) − 46 (σ grows like ln³, the neglected part is < e^-40 relative). Error
+estimate: the same with panels halved.
 
 Hertz O-ring (soft seal, fixed dry p0(x)): sealing zone θ ∈ [θ_s, θ_e] with x = a(1 − cos θ),
 p0 = p_H sin θ, sin θ_s = p_a/p_H, sin θ_e = p_b/p_H (θ_e = π for p_b = 0). Eq. (33) is
@@ -62,28 +64,31 @@ def uniform_reference(psd, *, p0, dp, L, L_y, E_star, eta, theory, p_b=0.0, a_pe
                       alpha_cj=1.0, width=0.25, nodes=16, sigma=None):
     """(Q [m³/s], relative error estimate) of a flat ring (closed form of eq. 33 for uniform p0).
 
-    σ_eff is evaluated directly at every quadrature node, or by ``sigma(p)`` if given (e.g. a
-    :class:`SigmaInterp` for the slow effective-medium theory; the integral is then cut at
-    its lower bound, which neglects < 1e-12 of Q)."""
+    The integral runs over the offset u = t_b − t in [0, W] below t_b = ln(p0 − p_b), with the
+    width W = −ln(1 − dp/(p0 − p_b)) formed directly from dp (log1p), never as a difference
+    ln(p0 − p_b) − ln(p0 − p_a): tiny dp keeps all its digits. σ_eff is evaluated directly at
+    every quadrature node, or by ``sigma(p)`` if given (e.g. a :class:`SigmaInterp` for the
+    slow effective-medium theory; the integral is then cut at its lower bound, which neglects
+    < 1e-12 of Q)."""
     p_a = p_b + dp
     hi = p0 - p_b
-    lo = p0 - p_a
     if dp == 0:
         return 0.0, 0.0
-    if lo < 0:
+    if p_a > p0:
         return math.inf, 0.0
     tb = math.log(hi)
-    ta = math.log(lo) if lo > 0 else tb - 46.0
+    W = -math.log1p(-dp / hi) if dp < hi else 46.0
+    W = min(W, 46.0)
     if sigma is not None:
-        ta = max(ta, sigma.t_lo)
+        W = min(W, tb - sigma.t_lo)
 
     def integral(w):
-        m = max(1, int(math.ceil((tb - ta) / w)))
-        edges = np.linspace(ta, tb, m + 1)
+        m = max(1, int(math.ceil(W / w)))
+        edges = W * np.arange(m + 1) / m            # offsets u from t_b (exact near u = 0)
         z, wt = _gl(nodes)
         h = 0.5 * np.diff(edges)
         mid = 0.5 * (edges[1:] + edges[:-1])
-        t = (mid[:, None] + h[:, None] * z[None, :]).ravel()
+        t = tb - (mid[:, None] + h[:, None] * z[None, :]).ravel()
         ww = (h[:, None] * wt[None, :]).ravel()
         if sigma is None:
             s = sigma_direct(psd, np.exp(t), E_star, eta, theory, a_perc, alpha_cj)
