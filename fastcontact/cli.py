@@ -19,11 +19,15 @@ message on stderr, no traceback.
 from __future__ import annotations
 
 import argparse
+import atexit
+import gc
 import importlib
 import importlib.util
 import json
 import math
+import os
 import sys
+import threading
 from pathlib import Path
 
 from .studies.progress import Progress
@@ -131,8 +135,9 @@ def build_parser():
     r.add_argument("--default", action="store_true", help="run the default scene (embedded tables)")
     r.add_argument("-o", "--outdir", required=True,
                    help="output folder (created; files in an existing folder are replaced)")
-    r.add_argument("--cache-dir", help="table cache folder (default: $FASTCONTACT_CACHE_DIR, "
-                   "else the user cache folder from platformdirs, + /tables)")
+    r.add_argument("--cache-dir", help="cache folder of tables and squeeze time primitives "
+                   "(default: $FASTCONTACT_CACHE_DIR, else the user cache folder from "
+                   "platformdirs, + /tables)")
     r.add_argument("--max-cases", type=_count, default=None,
                    help="largest study allowed, cases x surfaces (default: the scene's "
                         "[outputs] max_cases, else 2e7)")
@@ -460,17 +465,63 @@ def _dispatch(a):
             "sweep": _cmd_sweep, "figures": _cmd_figures}[a.command]
 
 
+#: first-generation threshold of Python's cycle collector while a command runs: its lazy
+#: imports allocate millions of objects and free few, and the default (700) makes the
+#: collector traverse them hundreds of times (~0.25 s of a 2 s run); cycles are still
+#: collected, every 1e5 allocations
+GC_THRESHOLD = 100_000
+#: commands that, run from the command line, end the process as soon as they are done
+#: (:func:`_leave`); not ``sweep`` and ``bem`` (Dask clusters and workers shut down normally)
+_LEAVE_AT_ONCE = frozenset({"run", "validate", "scenes", "tables", "figures", "roaddb"})
+
+
+def _leave(code):
+    """End the process with ``code`` now: the exit handlers run and the standard streams
+    are flushed, but the interpreter's teardown is skipped (it spends ~0.3 s CPU freeing
+    numba's and LLVM's objects after a kernel has run). Returns (does nothing) while any
+    other non-daemon thread is alive or a profiler, tracer or debugger is attached (cProfile,
+    coverage, pdb write or finish after ``main`` returns)."""
+    if sys.getprofile() is not None or sys.gettrace() is not None:
+        return
+    if any(t is not threading.main_thread() and t.is_alive() and not t.daemon
+           for t in threading.enumerate()):
+        return
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(code)
+
+
 def main(argv=None, out=None, err=None):
     """Entry point; returns the exit code (0 ok, 1 failure, 2 bad input, 130 interrupted).
 
     Bad input (SceneError, ValueError, a missing file, an unwritable folder) is reported in
-    one line on ``err``, never as a traceback.
+    one line on ``err``, never as a traceback. Called with no arguments (the ``fastcontact``
+    command, ``python -m fastcontact``), a finished ``run``, ``figures``, ``tables``, ...
+    leaves the process at once with its exit code (:func:`_leave`).
     """
+    command = [None]
+    threshold = gc.get_threshold()
+    gc.set_threshold(GC_THRESHOLD, *threshold[1:])
+    try:
+        code = _main(argv, out, err, command)
+    finally:
+        gc.set_threshold(*threshold)
+    if argv is None and out is None and err is None and command[0] in _LEAVE_AT_ONCE:
+        _leave(code)
+    return code
+
+
+def _main(argv, out, err, command):
     out = out or sys.stdout
     err = err or sys.stderr
     parser = build_parser()
     try:
         a = parser.parse_args(argv)
+        command[0] = a.command
         if a.command is None:
             parser.print_help(out)
             return EXIT_BAD_INPUT

@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.special import erf, erfinv as sp_erfinv
 
 from .._core.validate import check_positive, check_range
 from ..kernels.special import erfinv
@@ -71,6 +70,7 @@ def area_fraction(psd, p, E_star, zeta=None):
     G = _stiffness(psd, E_star, zeta)
     with np.errstate(divide="ignore"):
         x = p / (2.0 * np.sqrt(G))
+    from scipy.special import erf   # here: importing fastcontact needs no scipy.special
     return erf(x)
 
 
@@ -95,6 +95,7 @@ def percolation_pressure(psd, E_star, a_perc=0.5):
     E_star = check_positive("E_star", E_star, "[Pa]")
     a_perc = check_range("a_perc", a_perc, 0.0, 1.0, "[-]", lo_open=True, hi_open=True)
     G1 = 0.25 * math.pi * E_star ** 2 * psd.cum3[-1]
+    from scipy.special import erfinv as sp_erfinv
     return 2.0 * np.sqrt(G1) * sp_erfinv(a_perc)
 
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.special import beta as beta_fn, digamma
 
 from .._core.validate import check_positive, check_range
 from ..kernels.quadrature import gauss_legendre
@@ -210,6 +209,7 @@ def asymptote_self_affine(h_rms, hurst, q0, gamma=1.0):
     H = float(check_range("hurst", hurst, 0.0, 1.0, "[-]", lo_open=True, hi_open=True))
     q0 = float(check_positive("q0", q0, "[1/m]"))
     gamma = _check_gamma(gamma)
+    from scipy.special import beta as beta_fn, digamma   # here: import fastcontact stays light
     b = H / (2.0 - 2.0 * H)
     u0 = h_rms * math.sqrt(H / (math.pi * (2.0 - 2.0 * H))) * beta_fn(0.5, b)
     beta = (q0 * h_rms * math.exp(-0.5 * EULER_GAMMA) * math.sqrt(H / (2.0 - 2.0 * H))

@@ -13,10 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..seal import hertz_contact, seal_profile
 from ..squeeze.tire import profile_factors
-from .canvas import new_figure, save_png
-from .tire_figures import _curve_colors, draw_tire_curves, tire_curve
+from .canvas import log_axis, new_figure, save_png
+from .tire_figures import _curve_colors, draw_tire_curves, tire_curves
 
 __all__ = ["make_scene_figure", "MAX_CURVES_PER_PANEL", "UNIT_LABELS"]
 
@@ -24,7 +23,7 @@ __all__ = ["make_scene_figure", "MAX_CURVES_PER_PANEL", "UNIT_LABELS"]
 #: title says "n of m cases"
 MAX_CURVES_PER_PANEL = 60
 #: time samples per ū(t) curve (log-spaced; ~10 per decade)
-CURVE_POINTS = 100
+CURVE_POINTS = 60
 #: resolution of the run figures [dots per inch]
 DPI = 120
 #: display scale and unit of the case parameters in labels
@@ -118,13 +117,25 @@ def _p_eval(scene, row):
     return float(row["p0"])
 
 
-def _curve(scene, T, row):
+def _curves(scene, T, rows):
+    """The ū(t) curves of ``rows`` (cases of one surface), batched per theory and start."""
     ratios = scene.fixed.get("ratios") or (1.1, 1.01, 1.001)
     du = scene.fixed.get("du_complete") or (scene.fixed.get("du") or (1e-6,))[0]
-    u0 = float(row["u_start"]) if "u_start" in row and np.isfinite(float(row["u_start"])) else None
-    return tire_curve(T, p0=_p_eval(scene, row), E_star=float(row["E_star"]), R=float(row["R"]),
-                      eta=float(row["eta"]), theory=row["theory"], u_start=u0, ratios=ratios,
-                      du=du, label=_case_label(scene, row, _SQUEEZE_KEYS), n=CURVE_POINTS)
+    groups = {}
+    for i, row in enumerate(rows):
+        u0 = float(row["u_start"]) if "u_start" in row else math.nan
+        groups.setdefault((row["theory"], bool(np.isfinite(u0))), []).append(i)
+    curves = [None] * len(rows)
+    for (theory, has_start), idx in groups.items():
+        sel = [rows[i] for i in idx]
+        out = tire_curves(
+            T, p0=[_p_eval(scene, r) for r in sel], E_star=[float(r["E_star"]) for r in sel],
+            R=[float(r["R"]) for r in sel], eta=[float(r["eta"]) for r in sel], theory=theory,
+            u_start=[float(r["u_start"]) for r in sel] if has_start else None, ratios=ratios,
+            du=du, labels=[_case_label(scene, r, _SQUEEZE_KEYS) for r in sel], n=CURVE_POINTS)
+        for i, c in zip(idx, out):
+            curves[i] = c
+    return curves
 
 
 def _history_figure(scene, fig_name, tables, results, path):
@@ -141,7 +152,7 @@ def _history_figure(scene, fig_name, tables, results, path):
     any_trapped = False
     for ax, name in zip(axs, names):
         rows, total = _thin([r for _, r in ok[ok["surface"] == name].iterrows()])
-        curves = [_curve(scene, tables[name], r) for r in rows]
+        curves = _curves(scene, tables[name], rows)
         any_trapped = any_trapped or any(c["trapped"] for c in curves)
         draw_tire_curves(ax, curves, quantity, t_mark,
                          "time in footprint:" if t_mark else None, labels=len(curves) <= 8)
@@ -155,9 +166,9 @@ def _history_figure(scene, fig_name, tables, results, path):
         ax.set_title(title, fontsize=8)
     ax0 = axs[0]
     ax0.plot([], [], color="0.4", lw=0.8, ls="--",
-             label=r"$\bar u/\bar u_\infty$ = 1.1, 1.01, 1.001 (- -, -., :)")
+             label="ū/ū(∞) = 1.1, 1.01, 1.001 (- -, -., :)")
     if any_trapped:
-        ax0.plot([], [], color="0.4", lw=1.0, ls="-.", label=r"trapped: $\bar u_{\rm trap}$")
+        ax0.plot([], [], color="0.4", lw=1.0, ls="-.", label="trapped: ū_trap")
     if quantity == "u":
         ax0.plot([], [], color="0.4", lw=0.6, label="flat surfaces")
     _finish(fig, axs, scene.title, legend_loc="upper right")
@@ -185,11 +196,13 @@ def _t_star_figure(scene, results, path):
         if (~fin).any():
             ax.plot(xv[~fin], np.full((~fin).sum(), top * 3), "^", mfc="none", color=col, ms=6)
     if (~np.isfinite(ok["t_star"].to_numpy(float))).any():
-        ax.plot([], [], "^", mfc="none", color="0.3", label=r"trapped ($t^* = \infty$)")
+        ax.plot([], [], "^", mfc="none", color="0.3", label="trapped (t* = ∞)")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    log_axis(ax.xaxis)
+    log_axis(ax.yaxis)
     ax.set_xlabel(f"{x} ({_SI_UNIT.get(x, '-')})")
-    ax.set_ylabel(r"squeeze-out time $t^*$ (s), $\bar u(t^*) = 1.01\,\bar u_\infty$")
+    ax.set_ylabel("squeeze-out time t* (s), ū(t*) = 1.01 ū(∞)")
     _finish(fig, [ax], scene.title)
     return save_png(fig, path, dpi=DPI)
 
@@ -198,6 +211,7 @@ def _t_star_figure(scene, results, path):
 def _seal_p_ref(scene, rows):
     """p0 of a flat ring, or the Hertz peak pressure, for each row [Pa]."""
     if scene.fixed.get("profile") == "hertz":
+        from ..seal import hertz_contact   # seal engine only for seal scenes
         return np.asarray(hertz_contact(rows["R"].to_numpy(float), rows["f_N"].to_numpy(float),
                                         rows["E_star"].to_numpy(float))[1], float).ravel()
     return rows["p0"].to_numpy(float)
@@ -225,9 +239,10 @@ def _leak_figure(scene, results, path):
     if sealed:
         ax.plot([], [], "v", mfc="none", color="0.3", label="Q = 0 (percolated: sealed)")
     ax.set_yscale("log")
-    ax.set_xlabel(r"$\Delta p / p_0$" + (r" ($p_0$: Hertz peak pressure)"
+    log_axis(ax.yaxis)
+    ax.set_xlabel("Δp / p₀" + (" (p₀: Hertz peak pressure)"
                                          if scene.fixed.get("profile") == "hertz" else ""))
-    ax.set_ylabel(r"leak rate $Q$ (m$^3$/s)")
+    ax.set_ylabel("leak rate Q (m³/s)")
     _finish(fig, [ax], scene.title)
     return save_png(fig, path, dpi=DPI)
 
@@ -244,6 +259,7 @@ def _seal_profile_kwargs(scene, row, dp):
 
 
 def _profiles_figure(scene, tables, results, path):
+    from ..seal import seal_profile   # seal engine only for seal scenes
     ok = results[results["error"] == ""]
     names = list(dict.fromkeys(ok["surface"]))
     fig = _figure(max(len(names), 1))
@@ -256,12 +272,12 @@ def _profiles_figure(scene, tables, results, path):
             prof = seal_profile(tables[name], **_seal_profile_kwargs(scene, row, dp))
             x = prof["x"].to_numpy(float) * 1e3
             ax.plot(x, prof["p_cont"].to_numpy(float) / 1e3, color=_SEAL_COLORS[j],
-                    label=rf"$p_{{\rm cont}}$, $\Delta p/p_0$ = {frac:g}")
+                    label=f"p_cont, Δp/p₀ = {frac:g}")
             ucol = "u" if "u" in prof else [c for c in prof.columns if c.startswith("u")][0]
             ax2.plot(x, prof[ucol].to_numpy(float) * 1e6, color=_SEAL_COLORS[j], ls="--")
         ax.set_xlabel("x (mm)")
-        ax.set_ylabel(r"contact pressure $p_{\rm cont}$ (kPa)")
-        ax2.set_ylabel(r"separation $\bar u$ (µm), dashed")
+        ax.set_ylabel("contact pressure p_cont (kPa)")
+        ax2.set_ylabel("separation ū (µm), dashed")
         ax.set_title(f"{_surface_label(scene, name)}: {_case_label(scene, row) or 'first case'}",
                      fontsize=8)
     _finish(fig, axs, scene.title, legend_loc="upper center")

@@ -23,18 +23,18 @@ import sys
 from pathlib import Path
 
 import matplotlib
-import matplotlib.ticker
 import numpy as np
 
 from .._core.vocab import DEFAULT_THEORY, column_name
 from ..contact.elasticity import effective_modulus
-from ..squeeze import squeeze_history, squeeze_out
+from ..squeeze import squeeze_out
 from ..squeeze.reduced import flat_separation
 from ..tables import Tables
 from ..tables.defaults import default_table_path
-from .canvas import new_figure as _new_figure, save_png as _save_atomic
+from .canvas import log_axis, new_figure as _new_figure, save_png as _save_atomic
 
-__all__ = ["make_tire_figures", "tire_curve", "plot_tire_curves", "draw_tire_curves", "PAPER"]
+__all__ = ["make_tire_figures", "tire_curve", "tire_curves", "plot_tire_curves",
+           "draw_tire_curves", "PAPER"]
 
 PAPER = dict(p0=0.2e6, E=10e6, nu=0.5, R=0.02, eta=1e-3, rho=1000.0, u_start=1e-2,
              footprint_length=0.1, speed=30.0, theory="average", ratios=(1.1, 1.01, 1.001),
@@ -50,28 +50,95 @@ def tire_curve(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=PAP
     """ū(t), Δu(t), flat-surface ū(t), ū∞ and the ratio/Δu times of one tread-block case.
 
     The time axis spans from well before the film starts to thin to 10× the last ratio time
-    (or to 1e3× the first if the fluid is trapped).
+    (or to 1e3× the first if the fluid is trapped). One case of :func:`tire_curves`.
     """
-    sq = squeeze_out(tables, p0=p0, E_star=E_star, R=R, eta=eta, theory=theory, u_start=u_start,
-                     ratios=tuple(ratios), du=(du,), times=(), method="quad")
-    row = sq.iloc[0]
-    t_r = [float(row[_column(sq, "t_ratio", r)]) for r in ratios]
-    t_du = float(row[_column(sq, "t_du", du)])
-    u_inf = float(row["u_inf"])
-    u0 = float(row["u_start"]) if "u_start" in sq else float(u_start)
-    finite = [t for t in t_r + [t_du] if math.isfinite(t) and t > 0]
+    return tire_curves(tables, p0=[p0], E_star=[E_star], R=[R], eta=[eta], theory=theory,
+                       u_start=None if u_start is None else [u_start], ratios=ratios, du=du,
+                       labels=[label], n=n)[0]
+
+
+def _time_span(t_r, t_du, u0, p0, eta, R):
+    """(t_lo, t_hi) [s] of one case's curve: from well before the film starts to thin
+    (4 u0² p0 t/(3ηR²) ~ 1, the flat-surface law) to 10× the last finite target time."""
+    finite = [t for t in list(t_r) + [t_du] if math.isfinite(t) and t > 0]
     t_hi = 10.0 * max(finite) if finite else 1.0
-    # the film starts to thin when 4 u0² p0 t/(3ηR²) ~ 1 (flat-surface law)
     t_thin = 3.0 * eta * R ** 2 / (4.0 * u0 ** 2 * p0)
-    t_lo = min(t_thin * 1e-2, (min(finite) if finite else t_hi) * 1e-3)
-    t = np.logspace(math.log10(t_lo), math.log10(t_hi), n)
-    h = squeeze_history(tables, p0, E_star, R, eta, theory, t, u_start=u_start)
-    u = h["u"].to_numpy(float)
-    flat = np.asarray(flat_separation(u0, t, p0, eta, R), float)
-    return dict(label=label, t=t, u=u, du=u - u_inf, flat=flat, u_inf=u_inf, u_start=u0,
-                t_ratios=dict(zip(ratios, t_r)), t_du=t_du, du_level=du,
-                trapped=bool(row["trapped"]) if "trapped" in sq else False,
-                u_trap=float(row["u_trap"]) if "u_trap" in sq else math.nan)
+    return min(t_thin * 1e-2, (min(finite) if finite else t_hi) * 1e-3), t_hi
+
+
+def tire_curves(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=None,
+                ratios=PAPER["ratios"], du=PAPER["du_complete"], labels=None, n=400):
+    """The curves of :func:`tire_curve` for many cases of one surface and theory at once.
+
+    Parameters
+    ----------
+    tables : Tables
+    p0, E_star, R, eta : array_like
+        One value per case: pressure [Pa], effective modulus [Pa], radius [m], viscosity
+        [Pa·s].
+    theory : str
+    u_start : array_like or None
+        Initial separations [m] (one per case), or None: the engine's default start.
+    ratios, du :
+        Targets ū/ū∞ (vertical lines) and the Δu level [m].
+    labels : list of str, optional
+    n : int
+        Samples per curve (log-spaced over the case's own time span; the cases share one
+        log grid of at least this density).
+
+    Returns
+    -------
+    list of dict
+        Per case: ``label``, ``t`` [s], ``u``, ``du``, ``flat`` [m] (Stefan law from the same
+        start), ``u_inf``, ``u_start`` [m], ``t_ratios`` {ratio: t [s]}, ``t_du`` [s],
+        ``du_level`` [m], ``trapped``, ``u_trap`` [m].
+
+    Two calls of :func:`fastcontact.squeeze.squeeze_out` (``method="quad"``) for all cases:
+    the target times, then ū on the shared time grid. A case the engine does not run
+    (status other than "ok" or "trapped", e.g. a start below ū∞) gets an empty curve.
+    """
+    p0, E_star, R, eta = (np.atleast_1d(np.asarray(v, float)) for v in (p0, E_star, R, eta))
+    m = p0.size
+    labels = [""] * m if labels is None else list(labels)
+    us = None if u_start is None else np.atleast_1d(np.asarray(u_start, float))
+    kw = dict(p0=p0, E_star=E_star, R=R, eta=eta, theory=theory, u_start=us, method="quad")
+    sq = squeeze_out(tables, ratios=tuple(ratios), du=(du,), times=(), **kw)
+    t_r = np.array([sq[_column(sq, "t_ratio", r)].to_numpy(float) for r in ratios]).reshape(
+        len(ratios), m)
+    t_du = sq[_column(sq, "t_du", du)].to_numpy(float)
+    u_inf = sq["u_inf"].to_numpy(float)
+    u0 = sq["u_start"].to_numpy(float)
+    with np.errstate(invalid="ignore"):
+        spans = np.log10([_time_span(t_r[:, i], t_du[i], u0[i], p0[i], eta[i], R[i])
+                          for i in range(m)]).reshape(m, 2)
+    lo, hi = spans[:, 0], spans[:, 1]
+    ok = (np.isfinite(lo) & np.isfinite(hi)        # not: a start at or below ū∞, overflow
+          & sq["status"].isin(("ok", "trapped")).to_numpy(bool))
+    grid, U = np.zeros(0), np.zeros((m, 0))
+    if ok.any():
+        per_decade = (n - 1) / max(float(np.min(hi[ok] - lo[ok])), 1e-9)
+        n_grid = int(min(max(n, math.ceil(per_decade * (hi[ok].max() - lo[ok].min())) + 1),
+                         8 * n))
+        grid = np.logspace(lo[ok].min(), hi[ok].max(), n_grid)
+        hist = squeeze_out(tables, ratios=(), du=(), times=tuple(grid), **kw)
+        U = hist[[c for c in hist.columns if c.startswith("u_at_")]].to_numpy(float)
+        if U.shape != (m, n_grid):
+            raise RuntimeError(f"squeeze_out returned ū at {U.shape[1]} of {n_grid} times")
+    trapped = sq["trapped"].to_numpy(bool)
+    u_trap = sq["u_trap"].to_numpy(float)
+    curves = []
+    for i in range(m):
+        keep = ((grid >= 10 ** lo[i] * (1 - 1e-12)) & (grid <= 10 ** hi[i] * (1 + 1e-12))
+                if ok[i] else np.zeros(grid.size, bool))
+        t, u = grid[keep], U[i, keep]
+        flat = (np.asarray(flat_separation(u0[i], t, p0[i], eta[i], R[i]), float) if ok[i]
+                else np.zeros(0))
+        curves.append(dict(label=labels[i], t=t, u=u, du=u - u_inf[i], flat=flat,
+                           u_inf=float(u_inf[i]), u_start=float(u0[i]),
+                           t_ratios=dict(zip(ratios, map(float, t_r[:, i]))),
+                           t_du=float(t_du[i]), du_level=du, trapped=bool(trapped[i]),
+                           u_trap=float(u_trap[i])))
+    return curves
 
 
 def _column(frame, prefix, value):
@@ -108,7 +175,7 @@ def _draw_curve(ax, c, col, quantity, label):
         key = round(math.log10(level), 2)
         if key not in labelled:                       # one label per distinct level
             labelled.add(key)
-            ax.annotate(rf"trapped: $\bar u_{{\rm trap}}$ = {c['u_trap'] * 1e6:.3g} µm",
+            ax.annotate(f"trapped: ū_trap = {c['u_trap'] * 1e6:.3g} µm",
                         xy=(0.98, level), xycoords=("axes fraction", "data"), xytext=(0, 3),
                         textcoords="offset points", ha="right", fontsize=7, color="0.15")
     styles = ("--", "-.", ":")
@@ -134,12 +201,12 @@ def draw_tire_curves(ax, curves, quantity="u", t_mark=None, t_mark_label=None, l
     if quantity == "du":
         lvl = curves[0]["du_level"] * 1e6 if curves else 1.0
         ax.axhline(lvl, color="k", lw=0.8, ls=":")
-        ax.annotate(rf"$\Delta u$ = {lvl:g} µm", xy=(0.02, lvl), xycoords=("axes fraction", "data"),
+        ax.annotate(f"Δu = {lvl:g} µm", xy=(0.02, lvl), xycoords=("axes fraction", "data"),
                     xytext=(0, 3), textcoords="offset points", fontsize=8)
         ymin = max(min(ymin, lvl / 10), lvl * 1e-4)
-        ax.set_ylabel(r"$\Delta u = \bar u(t) - \bar u(\infty)$ (µm)")
+        ax.set_ylabel("Δu = ū(t) − ū(∞) (µm)")
     else:
-        ax.set_ylabel(r"separation $\bar u$ (mm)")
+        ax.set_ylabel("separation ū (mm)")
     marks = [] if t_mark is None else list(np.atleast_1d(t_mark))
     for tm in marks:
         ax.axvline(tm, color="0.3", lw=1.2)
@@ -149,14 +216,15 @@ def draw_tire_curves(ax, curves, quantity="u", t_mark=None, t_mark_label=None, l
                     rotation=90)
     ax.set_xscale("log")
     ax.set_yscale("log")
+    log_axis(ax.xaxis, minor_labels=False)
+    log_axis(ax.yaxis)
     if np.isfinite(ymin) and ymax > 0:
         ax.set_ylim(ymin / 1.5, ymax * 1.5)
     if marks:
         lo, hi = ax.get_xlim()
         ax.set_xlim(lo, max(hi, 2.0 * max(marks)))
-    ax.set_xlabel(r"squeeze time $t$ (s)")
+    ax.set_xlabel("squeeze time t (s)")
     ax.grid(True, which="major", lw=0.3, alpha=0.5)
-    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
 def plot_tire_curves(curves, path, quantity="u", title="", t_mark=None, t_mark_label=None):
@@ -165,7 +233,7 @@ def plot_tire_curves(curves, path, quantity="u", title="", t_mark=None, t_mark_l
     fig = _new_figure(figsize=(6.4, 4.8))
     ax = fig.subplots()
     draw_tire_curves(ax, curves, quantity, t_mark, t_mark_label)
-    ax.plot([], [], color="0.4", lw=0.8, ls="--", label=r"$\bar u/\bar u_\infty$ = 1.1, 1.01, 1.001 (- -, -., :)")
+    ax.plot([], [], color="0.4", lw=0.8, ls="--", label="ū/ū(∞) = 1.1, 1.01, 1.001 (- -, -., :)")
     if quantity == "u":
         ax.plot([], [], color="0.4", lw=0.6, label="flat surfaces")
     ax.legend(loc="lower left", fontsize=8, frameon=False)

@@ -17,9 +17,7 @@ from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
-import scipy.special as sp
 from numba import njit
-from scipy.integrate import quad
 
 from .hermite import cubic_uniform
 from .quadrature import gauss_legendre
@@ -151,6 +149,8 @@ class KTable(NamedTuple):
 @lru_cache(maxsize=1)
 def k_table() -> KTable:
     """(tmin, dt, K, dK/dt, dt_r, ρ, dρ/dt) of the K(s0) Hermite tables (built once, ~ms)."""
+    import scipy.special as sp          # here, not at import: scipy.special and
+    from scipy.integrate import quad    # scipy.integrate cost ~0.4 s to import
     gl_x, gl_w = gauss_legendre(12)
     # ---- ratio table on [0, _R_TMAX]
     tr = np.linspace(0.0, _R_TMAX, _R_N)

@@ -14,7 +14,6 @@ from typing import Callable
 import numpy as np
 
 from .._core.vocab import DEFAULT_THEORY, column_name
-from ..seal import seal_leak
 from ..squeeze import columns as squeeze_engine_columns
 from ..squeeze import squeeze_out
 from ..squeeze.api import units_of as squeeze_units
@@ -226,6 +225,7 @@ def _seal_base(tables, rows, theory, fixed, columns, **ext):
         kw.update(R=_col(rows, "R"), f_N=_col(rows, "f_N"))
     else:
         kw.update(p0=_col(rows, "p0"), L=_col(rows, "L"))
+    from ..seal import seal_leak   # here: a squeeze run never imports the seal engine
     df = seal_leak(tables, **kw, **ext).reset_index(drop=True)
     if len(df) != len(rows):
         raise RuntimeError(f"seal_leak returned {len(df)} rows for {len(rows)} cases")

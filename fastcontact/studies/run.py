@@ -29,13 +29,18 @@ from .progress import Progress
 from .scene import DEFAULT_CHUNK, Scene
 from .schema import input_units
 
-__all__ = ["run_scene", "RunResult", "provenance", "PAPER_REFERENCE", "FIGURE_MAX_ROWS"]
+__all__ = ["run_scene", "RunResult", "provenance", "PAPER_REFERENCE", "FIGURE_MAX_ROWS",
+           "PRIMITIVE_FOLDER"]
 
 PAPER_REFERENCE = reference_list(["lorenz_persson_2010_squeeze"])[0]
 #: figures are drawn only for studies of at most this many rows (all surfaces)
 FIGURE_MAX_ROWS = 200_000
 #: results are returned in memory (``RunResult.results``) up to this many rows
 KEEP_MAX_ROWS = 200_000
+#: sub-folder of the table cache that keeps the squeeze time primitives of squeeze and tire
+#: studies (:func:`fastcontact.squeeze.primitive.set_primitive_cache`): built once per
+#: (surface, theory), read by later runs
+PRIMITIVE_FOLDER = "squeeze_primitives"
 
 
 @dataclasses.dataclass
@@ -110,6 +115,24 @@ def _obtain_all(scene, cdir, log, prog):
         tables[name], records = T, records + [rec]
         prog.advance()
     return tables, records
+
+
+def _primitive_cache(scene, tables, cdir):
+    """Keep the squeeze time primitives of a squeeze or tire study in ``cdir``'s
+    :data:`PRIMITIVE_FOLDER`; returns the folder and the primitive files already there."""
+    if scene.kind not in ("squeeze", "tire"):
+        return None, set()
+    from ..squeeze.primitive import set_primitive_cache
+    folder = Path(cdir) / PRIMITIVE_FOLDER
+    for T in tables.values():
+        set_primitive_cache(T, folder)
+    return folder, set(folder.glob("*.parquet")) if folder.is_dir() else set()
+
+
+def _log_new_primitives(folder, before, log):
+    if folder is not None and folder.is_dir():
+        for p in sorted(set(folder.glob("*.parquet")) - before):
+            log(f"squeeze time primitive cached in {p}")
 
 
 def _evaluate_all(scene, tables, path, meta, chunk, prog):
@@ -280,11 +303,13 @@ def run_scene(scene: Scene, outdir, *, cache_dir=None, log=None, make_figures=No
     try:
         with Progress(steps, progress, progress_file) as prog:
             tables, records = _obtain_all(scene, cdir, log, prog)
+            pfolder, pbefore = _primitive_cache(scene, tables, cdir)
             results, failed, first_error, groups = _evaluate_all(
                 scene, tables, staging / "results.parquet", provenance(scene, records),
                 chunk_size, prog)
             figs, fig_note = _figures(scene, tables, results, staging / "figures", make_figures,
                                       log, prog)
+            _log_new_primitives(pfolder, pbefore, log)
         nrows = groups[-1][2] if groups else 0
         final = [outdir / "results.parquet"] + [outdir / "figures" / p.name for p in figs]
         files = [str(p) for p in final] + [str(outdir / "build_record.json"),

@@ -24,7 +24,6 @@ import pandas as pd
 from .._core.vocab import THEORIES
 from ..contact.elasticity import effective_modulus
 from ..surface.psd import SelfAffinePSD
-from ..surface.topography import read_psd
 from .schema import MAX_CASES
 
 __all__ = ["Scene", "SurfaceSpec", "SceneError", "DEFAULT_CHUNK"]
@@ -83,6 +82,7 @@ class SurfaceSpec:
             obj = SelfAffinePSD(self.params["h_rms"], self.params["hurst"], self.params["q0"],
                                 self.params["q1"], self.params.get("q_roll"))
         elif self.source == "psd":
+            from ..surface.topography import read_psd   # here: table-only runs stay light
             obj = read_psd(self.path, self.convention)
         else:
             raise ValueError(f"surface {self.name!r} is given as a table file")
