@@ -54,10 +54,10 @@ class Progress:
                 if self.bar is None:
                     from tqdm import tqdm
                     bar = tqdm(total=self.total, initial=self.n, file=self.file, unit="step",
-                               leave=False, dynamic_ncols=True,
+                               leave=False, dynamic_ncols=True, delay=self.delay,
                                mininterval=0.1 if self.tty else 10.0, desc=self.desc or None)
                     bar.start_t = self._t0            # the clock runs from the start of work
-                    bar.refresh()
+                    bar.refresh()                     # first drawn here, with that clock
                     self.bar = bar
         return self.bar
 
