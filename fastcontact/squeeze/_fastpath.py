@@ -137,9 +137,9 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
     The records are unpacked into plain arrays before the parallel loop, and the per-case
     work is inline in its body: a call per case with the records by value costs ten times
     the arithmetic. Ratio targets (same z for every case) come from the row tables ``rt``
-    unless the start lies within GUARD_Z above them (then from the start's interpolant
-    t_of_z, so that the difference stays >= 0); Δu targets from t_of_z; ū at times from the
-    inverse z_of_t."""
+    unless the start lies within GUARD_Z above them; there, and for Δu targets, both ends
+    come from t_of_z (one interpolant: the difference is accurate and >= 0 however close the
+    target is to the start); ū at times from its inverse z_of_t."""
     # one field per statement: with tuple unpacking (a, b = rec.a, rec.b) numba 0.6x's parfor
     # lowering keeps only the first array's writes, and a record-field setitem in the loop
     # body (rec.a[i] = x) is lost as well
@@ -184,16 +184,21 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
             if not (vs_in != vs_in or vs_in * h > vinf * h):  # as reported (SI)
                 _below_row(vinf, vs_in, h, x0, i, out)
             else:
-                if vs_in != vs_in:  # the default start: its T from the row table
+                # Ts: T at the start from t_of_z (-1: not computed yet); Ts_row: the default
+                # start's T from the row table, paired with row-table targets only
+                if vs_in != vs_in:
                     zs = row_value(pr.zs, st)
                     vs = vinf * (1.0 + math.exp(zs))
-                    Ts = math.exp(row_value(lnTs, st))
+                    Ts_row = math.exp(row_value(lnTs, st))
+                    Ts = -1.0
                 elif vs_in == math.inf:
                     zs, vs, Ts = math.inf, vs_in, 0.0
+                    Ts_row = Ts
                 else:
                     vs = vs_in
                     zs = math.log(vs / vinf - 1.0)
                     Ts = t_of_z(pr, st, vinf, zs)
+                    Ts_row = Ts
                 u_inf[i] = vinf * h
                 u_start[i] = vs * h
                 t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
@@ -211,13 +216,16 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
                     else:
                         z = zr[k] if k <= nr else math.log(r1)
                         if k <= nr and z < zs - GUARD_Z:
-                            Tk = math.exp(_row_col(lnT, st, k))
-                        else:
-                            Tk = t_of_z(pr, st, vinf, z)
-                        tk = tau * (Tk - Ts)
+                            tk = tau * (math.exp(_row_col(lnT, st, k)) - Ts_row)
+                        else:  # near the start: both ends from the same interpolant
+                            if Ts < 0.0:
+                                Ts = t_of_z(pr, st, vinf, zs)
+                            tk = tau * (t_of_z(pr, st, vinf, z) - Ts)
                     T_out[k, i] = tk
                     if tk == math.inf:
                         bad = True
+                if nU > 0 and Ts < 0.0:
+                    Ts = t_of_z(pr, st, vinf, zs)  # the inverse z_of_t pairs with t_of_z
                 for k in range(nU):
                     tt = times[k, i if per_case_times else i - i] / tau
                     if tt == 0.0:
