@@ -37,6 +37,7 @@ _LAZY = {
     "run_sweep": "studies.sweep", "read_sweep": "studies.sweep",
     "bem_reference": "validation", "compare_theories": "validation", "calibrate": "validation",
     "Calibration": "validation",
+    "DEFAULT_THEORY": "_core.vocab", "THEORIES": "_core.vocab",
 }
 #: sub-packages reachable as attributes (``fastcontact.contact``) without an explicit import
 _SUBPACKAGES = ("contact", "flow", "kernels", "seal", "squeeze", "studies", "surface", "tables",
