@@ -98,6 +98,8 @@ def uniform_reference(psd, *, p0, dp, L, L_y, E_star, eta, theory, p_b=0.0, a_pe
 
     I1 = integral(width)
     I2 = integral(width / 2)
+    if I2 == 0.0:                 # σ_eff = 0 at every node: percolated throughout, Q = 0
+        return 0.0, abs(I1)
     Q = L_y / L * I2
     return Q, abs(I1 / I2 - 1.0)
 
