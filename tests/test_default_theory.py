@@ -17,8 +17,8 @@ from fastcontact._core.vocab import DEFAULT_THEORY, THEORIES
 
 #: public functions with a ``theory`` parameter that keep a default of their own, and why
 EXEMPT = {
-    # direct-quadrature physics of fastcontact.flow: one σ_eff / φ_p at a time, not an engine
-    ("fastcontact.flow.conductivity", "conductivity"),
+    # the flow factor and the directional (Bruggeman) conductivity are effective-medium
+    # concepts: they default to the effective medium, "emt"
     ("fastcontact.flow.conductivity", "flow_factor"),
     ("fastcontact.flow.anisotropy", "sigma_directional"),
     # the asperity-cascade extension study (its levels use the effective medium by design)

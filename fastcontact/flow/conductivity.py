@@ -24,7 +24,7 @@ import numpy as np
 from numba import get_parallel_chunksize, set_parallel_chunksize
 
 from .._core.validate import check_positive, check_range
-from .._core.vocab import THEORIES
+from .._core.vocab import DEFAULT_THEORY, THEORIES
 from ..contact import _check_gamma, _check_psd, _separation, mean_separation
 from ..contact._kernels import PANEL, psd_kernel
 from ..kernels.quadrature import gauss_hermite, gauss_legendre
@@ -164,7 +164,7 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
     return SigmaBar(sig, perc, SigmaDetails(error_estimate=err, u1_evaluations=nev))
 
 
-def conductivity(psd, p, E_star, eta, theory="average", *, gamma=1.0, a_perc=0.5,
+def conductivity(psd, p, E_star, eta, theory=DEFAULT_THEORY, *, gamma=1.0, a_perc=0.5,
                  alpha_cj=1.0, tol=EMT_TOL, almqvist=False, emt_threshold=0.5):
     """Effective interfacial fluid conductivity σ_eff(p_cont) [m³/(Pa·s)] by direct quadrature.
 
@@ -179,7 +179,8 @@ def conductivity(psd, p, E_star, eta, theory="average", *, gamma=1.0, a_perc=0.5
     eta : float
         Fluid viscosity [Pa·s], > 0.
     theory : {"average", "critical_junction", "emt"}
-        Flow theory (default "average").
+        Flow theory (default :data:`~fastcontact._core.vocab.DEFAULT_THEORY`,
+        "critical_junction", as everywhere in the package).
     gamma : float
         Yang–Persson factor of ū(ζ) and u1(ζ) in (0, 1] [-] (1 = paper).
     a_perc : float
