@@ -64,8 +64,17 @@ def _sigma(tab, sc, x):
 
 
 @njit(cache=True)
-def _uniform_integral(tab, sc, E, p0, pa, pb, alpha, glx, glw, width):
-    """∫_{p_b}^{p_a} σ̄(p0 - p) e^{-α(p - p_b)} dp [Pa], in x = ln((p0 - p)/E*)."""
+def _ln_eta(p, A, Z, pr):
+    """ln(η/η0) at p >= 0 above the outlet: Barus (pr = 0: A = α, ln = α p) or Roelands."""
+    if pr == 0.0:
+        return A * p
+    return ln_roelands(p, A, Z, pr)
+
+
+@njit(cache=True)
+def _uniform_integral(tab, sc, E, p0, pa, pb, A, Z, pr, glx, glw, width):
+    """∫_{p_b}^{p_a} σ̄(p0 - p) η0/η(p - p_b) dp [Pa], in x = ln((p0 - p)/E*); the viscosity law
+    as in :func:`_ln_eta` (Barus: e^{-α(p - p_b)})."""
     xb = math.log((p0 - pb) / E)
     if pa >= p0:
         xa = sc[0] - TAIL_CUT
@@ -82,15 +91,17 @@ def _uniform_integral(tab, sc, E, p0, pa, pb, alpha, glx, glw, width):
         for j in range(glx.size):
             x = mid + 0.5 * hw * glx[j]
             pc = E * math.exp(x)
-            s += 0.5 * hw * glw[j] * _sigma(tab, sc, x) * pc * math.exp(-alpha * (p0 - pb - pc))
+            s += 0.5 * hw * glw[j] * _sigma(tab, sc, x) * pc * math.exp(
+                -_ln_eta(max(p0 - pb - pc, 0.0), A, Z, pr))
     return s
 
 
 @njit(parallel=True, cache=True)
-def _uniform_kernel(tab, sc, p0, L, pa, pb, E, alpha, glx, glw, width, out):
+def _uniform_kernel(tab, sc, p0, L, pa, pb, E, A, Z, pr, glx, glw, width, out):
+    """q = (1/L) ∫ σ̄ η0/η dp of each ring (pr = 0: Barus with A = α, Z unused)."""
     for i in prange(p0.size):
-        out[i] = _uniform_integral(tab, sc, E[i], p0[i], pa[i], pb[i], alpha[i], glx, glw,
-                                   width) / L[i]
+        out[i] = _uniform_integral(tab, sc, E[i], p0[i], pa[i], pb[i], A[i], Z[i], pr, glx,
+                                   glw, width) / L[i]
 
 
 @njit(cache=True)
@@ -198,37 +209,6 @@ def _hertz_kernel(tab, sc, E, pH, a, pa, pb, alpha, n, k, ok):
 
 
 # =========================================================================== Roelands
-@njit(cache=True)
-def _uniform_integral_r(tab, sc, E, p0, pa, pb, A, Z, pr, glx, glw, width):
-    """∫_{p_b}^{p_a} σ̄(p0 - p) η0/η(p - p_b) dp [Pa] (Roelands), in x = ln((p0 - p)/E*)."""
-    xb = math.log((p0 - pb) / E)
-    if pa >= p0:
-        xa = sc[0] - TAIL_CUT
-    else:
-        xa = math.log((p0 - pa) / E)
-        xa = max(xa, sc[0] - TAIL_CUT)
-    if not xb > xa:
-        return 0.0
-    m = max(1, int(math.ceil((xb - xa) / width)))
-    hw = (xb - xa) / m
-    s = 0.0
-    for k in range(m):
-        mid = xa + (k + 0.5) * hw
-        for j in range(glx.size):
-            x = mid + 0.5 * hw * glx[j]
-            pc = E * math.exp(x)
-            s += 0.5 * hw * glw[j] * _sigma(tab, sc, x) * pc * math.exp(
-                -ln_roelands(max(p0 - pb - pc, 0.0), A, Z, pr))
-    return s
-
-
-@njit(parallel=True, cache=True)
-def _uniform_kernel_r(tab, sc, p0, L, pa, pb, E, A, Z, pr, glx, glw, width, out):
-    for i in prange(p0.size):
-        out[i] = _uniform_integral_r(tab, sc, E[i], p0[i], pa[i], pb[i], A[i], Z[i], pr, glx,
-                                     glw, width) / L[i]
-
-
 @njit(cache=True)
 def _rhs_r(tab, sc, E, pH, a, th_s, span, t, p, pb, A, Z, pr, k):
     """dp_f/dt = -k a sin θ (η/η0)/σ̄(p0(θ) - p_f) dθ/dt; 0 in an open pocket."""
@@ -442,12 +422,10 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         if np.any(run):
             x, w = np.polynomial.legendre.leggauss(int(quad_order))
             out = np.empty(int(run.sum()))
-            if roelands:
-                sub = [np.ascontiguousarray(v[run]) for v in (p0v, Lv, pa, pb, E, rA, rZ)]
-                _uniform_kernel_r(tab, sc, *sub, rpr, x, w, float(quad_width), out)
-            else:
-                sub = [np.ascontiguousarray(v[run]) for v in (p0v, Lv, pa, pb, E, al)]
-                _uniform_kernel(tab, sc, *sub, x, w, float(quad_width), out)
+            A, Z, pr = (rA, rZ, rpr) if roelands else (al, np.zeros(E.size), 0.0)
+            sub = [np.ascontiguousarray(v[run], dtype=np.float64)
+                   for v in (p0v, Lv, pa, pb, E, A, Z)]
+            _uniform_kernel(tab, sc, *sub, float(pr), x, w, float(quad_width), out)
             kq[run] = out
         conv = np.ones(E.size, dtype=bool)
         cols.update({"p0": p0v, "L": Lv})

@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit, prange
 
 from . import _kernels as qk
-from .primitive import row_value, stencil, t_of_z, z_of_t
+from .primitive import Primitive, first_row, row_value, stencil, t_of_z, z_of_t
 
 __all__ = ["fast_kernel", "history_kernel", "one_case_primitive", "RowTargets", "row_targets"]
 
@@ -31,12 +31,7 @@ GUARD_Z = 1.0
 @njit(cache=True, inline="always")
 def _row_stencil(pr, j):
     """The stencil of row j itself (weight 1 on row j)."""
-    n = pr.xn.size
-    j0 = j - 1
-    if j0 < 0:
-        j0 = 0
-    if j0 > n - 4:
-        j0 = n - 4
+    j0 = first_row(pr, j)
     r = j - j0
     return (j0, 1.0 if r == 0 else 0.0, 1.0 if r == 1 else 0.0, 1.0 if r == 2 else 0.0,
             1.0 if r == 3 else 0.0)
@@ -267,9 +262,7 @@ def one_case_primitive(pr, x0):
     """(primitive, stencil) of the single pressure x0 = ln(p0/E*): the four rows combined
     once, so that every later lookup reads one small row that stays in cache (the same
     arithmetic as combining per lookup: weights 1, 0, 0, 0 reproduce it exactly)."""
-    from .primitive import Primitive, stencil as _st
-
-    st = _st(pr, x0)
+    st = stencil(pr, x0)
     if st[0] < 0:
         return None, st
     one = (0, 1.0, 0.0, 0.0, 0.0)

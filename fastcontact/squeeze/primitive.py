@@ -89,18 +89,24 @@ def _locate(pr, x):
 
 
 @njit(cache=True, inline="always")
+def first_row(pr, j):
+    """First of the four rows j0..j0+3 used around interval j (clamped to the grid)."""
+    j0 = j - 1
+    if j0 < 0:
+        j0 = 0
+    if j0 > pr.xn.size - 4:
+        j0 = pr.xn.size - 4
+    return j0
+
+
+@njit(cache=True, inline="always")
 def stencil(pr, x0):
     """(j0, w0, w1, w2, w3): 4-point Lagrange weights of x0 over rows j0..j0+3 (j0 = -1:
     outside the rows)."""
     j = _locate(pr, x0)
     if j < 0:
         return -1, 0.0, 0.0, 0.0, 0.0
-    n = pr.xn.size
-    j0 = j - 1
-    if j0 < 0:
-        j0 = 0
-    if j0 > n - 4:
-        j0 = n - 4
+    j0 = first_row(pr, j)
     a, b, c, d = pr.xn[j0], pr.xn[j0 + 1], pr.xn[j0 + 2], pr.xn[j0 + 3]
     w0 = (x0 - b) * (x0 - c) * (x0 - d) / ((a - b) * (a - c) * (a - d))
     w1 = (x0 - a) * (x0 - c) * (x0 - d) / ((b - a) * (b - c) * (b - d))

@@ -27,7 +27,8 @@ import pandas as pd
 from numba import njit, prange
 
 from .api import STATUS_NAMES
-from .viscosity import DEFAULT_P_START, _lnv_of_lnp, _rate_factor, _scalars, _segment, _state
+from .viscosity import (DEFAULT_P_START, _lnv_of_lnp, _rate_factor, _scalars, _segment, _state,
+                        _target_times)
 
 __all__ = ["QUAD_ORDER", "QUAD_WIDTH", "STATUS", "barus_tire_columns"]
 
@@ -83,7 +84,6 @@ def _exit_w(tab, sc, x0, api, vinf, w0, target, glx, glw, width):
 def _tire_kernel(tab, sc, p0, E, R, eta, alpha, us, t_fp, h, vt_ratio, vt_dv, glx, glw, width,
                  T, u_exit, uinf, ustart, u_trap, flf, status):
     """Per case: targets (ratios × v∞, then v∞ + dv) and ū at t_fp (SI outputs)."""
-    nr = vt_ratio.size
     nt = T.shape[0]
     for i in prange(p0.size):
         x0 = math.log(p0[i] / E[i])
@@ -122,23 +122,7 @@ def _tire_kernel(tab, sc, p0, E, R, eta, alpha, us, t_fp, h, vt_ratio, vt_dv, gl
             flf[i] = math.nan
             u_trap[i] = math.nan
             continue
-        vts = np.empty(nt)
-        for k in range(nt):
-            vts[k] = vt_ratio[k] * vinf if k < nr else vinf + vt_dv[k - nr]
-        order = np.argsort(-vts)
-        v_cur = vs
-        t_cur = 0.0
-        for kk in range(nt):
-            k = order[kk]
-            vt = vts[k]
-            if vt >= vs:
-                T[k, i] = 0.0
-                continue
-            if vt < v_cur:
-                t_cur += _segment(tab, sc, x0, api, vinf, math.log(vt - vinf),
-                                  math.log(v_cur - vinf), glx, glw, width)
-                v_cur = vt
-            T[k, i] = tau * t_cur
+        _target_times(tab, sc, x0, api, vinf, vs, vt_ratio, vt_dv, tau, glx, glw, width, T, i)
         w0 = math.log(vs - vinf)
         w = _exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, glx, glw, width)
         u_exit[i] = (vinf + math.exp(w)) * h

@@ -179,11 +179,35 @@ def _segment(tab, sc, x0, api, vinf, w1, w2, glx, glw, width):
     return s
 
 
+@njit(cache=True)
+def _target_times(tab, sc, x0, api, vinf, vs, vt_ratio, vt_dv, tau, glx, glw, width, T, i):
+    """Times [s] from v_start down to each target (ratios ū/ū∞, then Δu/h_rms) into column i
+    of T: one downward pass over the targets in descending order; 0 for targets passed."""
+    nt = T.shape[0]
+    nr = vt_ratio.size
+    vts = np.empty(nt)
+    for k in range(nt):
+        vts[k] = vt_ratio[k] * vinf if k < nr else vinf + vt_dv[k - nr]
+    order = np.argsort(-vts)
+    v_cur = vs
+    t_cur = 0.0
+    for kk in range(nt):
+        k = order[kk]
+        vt = vts[k]
+        if vt >= vs:
+            T[k, i] = 0.0
+            continue
+        if vt < v_cur:
+            t_cur += _segment(tab, sc, x0, api, vinf, math.log(vt - vinf),
+                              math.log(v_cur - vinf), glx, glw, width)
+            v_cur = vt
+        T[k, i] = tau * t_cur
+
+
 @njit(parallel=True, cache=True)
 def _piezo_kernel(tab, sc, p0, E, R, eta, alpha, us, h, vt_ratio, vt_dv, glx, glw, width,
                   T, uinf, ustart, tau0, gstart, status):
     """Per case: targets (ratios × v∞, then v∞ + dv) sorted downward, one pass (t̃ → SI)."""
-    nr = vt_ratio.size
     nt = T.shape[0]
     for i in prange(p0.size):
         x0 = math.log(p0[i] / E[i])
@@ -213,23 +237,7 @@ def _piezo_kernel(tab, sc, p0, E, R, eta, alpha, us, h, vt_ratio, vt_dv, glx, gl
             for k in range(nt):
                 T[k, i] = math.nan
             continue
-        vts = np.empty(nt)
-        for k in range(nt):
-            vts[k] = vt_ratio[k] * vinf if k < nr else vinf + vt_dv[k - nr]
-        order = np.argsort(-vts)
-        v_cur = vs
-        t_cur = 0.0
-        for kk in range(nt):
-            k = order[kk]
-            vt = vts[k]
-            if vt >= vs:
-                T[k, i] = 0.0
-                continue
-            if vt < v_cur:
-                t_cur += _segment(tab, sc, x0, api, vinf, math.log(vt - vinf),
-                                  math.log(v_cur - vinf), glx, glw, width)
-                v_cur = vt
-            T[k, i] = tau * t_cur
+        _target_times(tab, sc, x0, api, vinf, vs, vt_ratio, vt_dv, tau, glx, glw, width, T, i)
 
 
 # =========================================================================== model
