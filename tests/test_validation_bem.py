@@ -92,6 +92,36 @@ def test_parseval_of_the_realization():
     assert np.sqrt(np.mean(h ** 2)) == pytest.approx(psd.h_rms, rel=0.02)
 
 
+@pytest.mark.parametrize("n", [8, 16, 24, 64])
+def test_nested_uniform_sets_every_mode_nyquist_included(n):
+    # independent reference, one mode at a time: mode (i, j) (signed, fftfreq order) takes its
+    # number from the smallest grid m of the chain n, n/2, ... (>= 8) whose signed range
+    # [-(m//2), (m-1)//2] holds both indices, generator default_rng([seed, m])
+    from fastcontact.validation.bem import _nested_uniform
+    seed = 7
+    chain = [n]
+    while chain[-1] % 2 == 0 and chain[-1] // 2 >= 8:
+        chain.append(chain[-1] // 2)
+    draws = {m: np.random.default_rng([seed, m]).random((m, m)) for m in chain}
+    signed = [k if k < (n + 1) // 2 else k - n for k in range(n)]
+    ref = np.empty((n, n))
+    for a, i in enumerate(signed):
+        for b, j in enumerate(signed):
+            m = min(m for m in chain if -(m // 2) <= min(i, j) and max(i, j) <= (m - 1) // 2)
+            ref[a, b] = draws[m][i % m, j % m]
+    got = _nested_uniform(n, seed)
+    assert np.array_equal(got, ref)  # the Nyquist row/column (i = -n/2) included
+
+
+def test_realization_past_nyquist_is_finite():
+    # q1 beyond the grid's Nyquist wavevector: the Nyquist modes carry power, so an unset
+    # phase there would turn the map into NaN (seen on CI before the fix)
+    psd, L = _psd(q1_factor=64, roll=2)
+    h = surface_realization(psd, 16, L, seed=3)
+    assert np.all(np.isfinite(h))
+    assert np.sqrt(np.mean(h ** 2)) > 0.5 * psd.h_rms
+
+
 # ------------------------------------------------------------------ contact: Hertz
 def test_hertz_sphere_on_flat():
     n, box, R, E = 64, 1e-3, 5e-3, 1e7

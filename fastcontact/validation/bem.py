@@ -100,15 +100,18 @@ def _nested_uniform(n, seed):
         sizes.append(sizes[-1] // 2)
     i = np.fft.fftfreq(n, 1.0 / n).astype(np.int64)
     I, J = np.meshgrid(i, i, indexing="ij")
-    out = np.empty((n, n))
+    out = np.full((n, n), np.nan)
     done = np.zeros((n, n), dtype=bool)
     for m in reversed(sizes):  # smallest first
-        inside = ~done & (np.abs(I) < m // 2 + (m % 2)) & (np.abs(J) < m // 2 + (m % 2))
-        if m % 2 == 0:  # the signed range of an even m×m grid is [-m/2, m/2)
-            inside &= (I >= -(m // 2)) & (I < m // 2) & (J >= -(m // 2)) & (J < m // 2)
+        # the signed indices of an m×m grid run over [-(m//2), (m-1)//2] (fftfreq's order):
+        # [-m/2, m/2) for even m, Nyquist row and column included
+        lo, hi = -(m // 2), (m - 1) // 2
+        inside = ~done & (I >= lo) & (I <= hi) & (J >= lo) & (J <= hi)
         r = np.random.default_rng([int(seed), int(m)]).random((m, m))
         out[inside] = r[I[inside] % m, J[inside] % m]
         done |= inside
+    if not done.all():  # pragma: no cover - the largest grid is the whole lattice
+        raise AssertionError("_nested_uniform left lattice modes unset")
     return out
 
 
