@@ -15,14 +15,12 @@ Workers: :func:`local_cluster` (spawned processes, numba's fork-safe threading s
 from __future__ import annotations
 
 import contextlib
-import datetime as _dt
 import hashlib
 import json
 import logging
 import os
 import re
 import signal
-import socket
 import sys
 import threading
 import time
@@ -41,6 +39,8 @@ from .evaluate import empty_results, evaluate_cases
 from .load import load_scene
 from .output import write_json_atomic, write_parquet_atomic
 from .scene import Scene, SurfaceSpec
+from .sweep_control import (LOCK_NAME, LOCK_STALE_SECONDS, SweepError, SweepInterrupted,
+                            _ignore_signals, _interrupts, _Lock, _utc_now)
 
 __all__ = ["run_sweep", "read_sweep", "sweep_key", "worker_environment", "local_cluster",
            "SweepError", "SweepInterrupted", "LOCK_NAME", "LOCK_STALE_SECONDS"]
@@ -48,24 +48,6 @@ __all__ = ["run_sweep", "read_sweep", "sweep_key", "worker_environment", "local_
 DATA_DIR = "data"
 MANIFEST = "manifest.json"
 META_KEY = METADATA_KEY
-#: lock file of a running sweep, inside the output folder
-LOCK_NAME = ".sweep.lock"
-#: a lock from another host whose heartbeat is older than this [s] is stale
-LOCK_STALE_SECONDS = 120.0
-_HEARTBEAT_SECONDS = 5.0
-_EXIT_CODES = {signal.SIGINT: 130, signal.SIGTERM: 143}
-
-
-class SweepError(ValueError):
-    """Bad sweep input or an output folder in use (the CLI reports it in one line, exit 2)."""
-
-
-class SweepInterrupted(KeyboardInterrupt):
-    """SIGINT / SIGTERM ended a sweep; ``exit_code`` is 130 / 143 and ``str()`` one line."""
-
-    def __init__(self, message, exit_code):
-        super().__init__(message)
-        self.exit_code = exit_code
 
 
 def worker_environment(threads_per_worker=1):
@@ -91,10 +73,6 @@ def sweep_key(scene, db_fingerprint):
                        "options": scene.table_options, "theories": list(scene.theories),
                        "version": __version__}, sort_keys=True).encode()
     return hashlib.sha256(blob).hexdigest()
-
-
-def _utc_now():
-    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
 
 # ============================================================================ the task
@@ -139,116 +117,6 @@ def _read_partition_meta(path):
         return meta
     except Exception:  # noqa: BLE001 - unreadable → recompute
         return None
-
-
-# ============================================================================ the lock
-def _process_start(pid):
-    """Start time of process ``pid`` (clock ticks since boot, Linux), or None if unknown."""
-    try:
-        with open(f"/proc/{pid}/stat", "rb") as fh:
-            return int(fh.read().rsplit(b")", 1)[1].split()[19])
-    except (OSError, ValueError, IndexError):
-        return None
-
-
-def _alive(info):
-    """Whether the process that wrote lock ``info`` may still run."""
-    if info.get("host") != socket.gethostname():
-        return time.time() - float(info.get("heartbeat", 0.0)) < LOCK_STALE_SECONDS
-    pid = int(info.get("pid", -1))
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    start = _process_start(pid)
-    return info.get("start") is None or start is None or start == info.get("start")
-
-
-class _Lock:
-    """``OUT/.sweep.lock``: created exclusively, heartbeat every few seconds, removed on exit;
-    a stale lock (dead owner) is taken over."""
-
-    def __init__(self, outdir, log):
-        self.path = Path(outdir) / LOCK_NAME
-        self.log = log
-        self._stop = threading.Event()
-        self._thread = None
-        self.info = {"pid": os.getpid(), "host": socket.gethostname(),
-                     "start": _process_start(os.getpid()), "since": _utc_now()}
-
-    def _write_new(self):
-        self.info["heartbeat"] = time.time()
-        fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
-        with os.fdopen(fd, "w") as fh:
-            json.dump(self.info, fh)
-
-    def acquire(self):
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        for _ in range(3):
-            try:
-                self._write_new()
-                break
-            except FileExistsError:
-                try:
-                    other = json.loads(self.path.read_text() or "{}")
-                except (OSError, ValueError):
-                    other = {}
-                if other and _alive(other):
-                    raise SweepError(
-                        f"output folder {str(self.path.parent)!r} is in use by another sweep "
-                        f"(pid {other.get('pid')} on {other.get('host')} since "
-                        f"{other.get('since')}; lock {self.path.name}): wait for it to finish "
-                        f"or use another -o") from None
-                stale = self.path.with_name(f"{LOCK_NAME}.stale.{os.getpid()}")
-                with contextlib.suppress(FileNotFoundError):
-                    os.replace(self.path, stale)
-                    stale.unlink()
-                self.log(f"note: took over the stale lock of a dead sweep (pid "
-                         f"{other.get('pid')} on {other.get('host')})")
-        else:
-            raise SweepError(f"output folder {str(self.path.parent)!r}: cannot take the lock "
-                             f"{self.path.name} (another sweep is starting there)")
-        self._thread = threading.Thread(target=self._beat, daemon=True)
-        self._thread.start()
-        return self
-
-    def _beat(self):
-        while not self._stop.wait(_HEARTBEAT_SECONDS):
-            self.info["heartbeat"] = time.time()
-            with contextlib.suppress(OSError):
-                tmp = self.path.with_name(f"{LOCK_NAME}.{os.getpid()}.tmp")
-                tmp.write_text(json.dumps(self.info))
-                os.replace(tmp, self.path)
-
-    def release(self):
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join()
-        with contextlib.suppress(OSError, ValueError):
-            if json.loads(self.path.read_text()).get("pid") == os.getpid():
-                self.path.unlink()
-
-
-# ============================================================================ signals
-@contextlib.contextmanager
-def _interrupts():
-    """SIGINT / SIGTERM raise :class:`SweepInterrupted` in the main thread while inside."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def handler(signum, frame):
-        name = signal.Signals(signum).name
-        raise SweepInterrupted(name, _EXIT_CODES[signum])
-
-    old = {s: signal.signal(s, handler) for s in _EXIT_CODES}
-    try:
-        yield
-    finally:
-        for s, h in old.items():
-            signal.signal(s, h)
 
 
 # ============================================================================ cluster
@@ -494,19 +362,6 @@ def _run_locked(db, outdir, sc, ids, spectra, fingerprint, key, scheduler, worke
     write_json_atomic(mpath, manifest)
     return manifest
 
-
-@contextlib.contextmanager
-def _ignore_signals():
-    """A second Ctrl-C while the cluster shuts down must not leave it half-closed."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    old = {s: signal.signal(s, signal.SIG_IGN) for s in _EXIT_CODES}
-    try:
-        yield
-    finally:
-        for s, h in old.items():
-            signal.signal(s, h)
 
 
 def read_sweep(outdir):
