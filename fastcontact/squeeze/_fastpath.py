@@ -125,16 +125,60 @@ def _flag_overflow(tau, tg, h, i, out):
         out.status[i] = qk.ST_OVERFLOW
 
 
+@njit(cache=True, inline="always")
+def _case_start(pr, st, vinf, vs_in, lnTs):
+    """(zs, v_start, Ts, Ts_row) of a served case: z and ū/h at the start, T at the start from
+    t_of_z (-1: not computed yet) and the default start's T from the row table ``lnTs``
+    (paired with row-table targets only)."""
+    if vs_in != vs_in:
+        zs = row_value(pr.zs, st)
+        return zs, vinf * (1.0 + math.exp(zs)), -1.0, math.exp(row_value(lnTs, st))
+    if vs_in == math.inf:
+        return math.inf, vs_in, 0.0, 0.0
+    zs = math.log(vs_in / vinf - 1.0)
+    Ts = t_of_z(pr, st, vinf, zs)
+    return zs, vs_in, Ts, Ts
+
+
+@njit(cache=True, inline="always")
+def _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, nr, r1s, zr, dvs, lnT):
+    """(t [s] from the start to target k, Ts): target k <= nr is t_star or a ratio (z from
+    ``zr``), above nr a Δu target; 0 for a target at or above the start."""
+    r1 = r1s[k] if k <= nr else dvs[k - 1 - nr] / vinf
+    if vinf * (1.0 + r1) >= vs:
+        return 0.0, Ts
+    z = zr[k] if k <= nr else math.log(r1)
+    if k <= nr and z < zs - GUARD_Z:
+        return tau * (math.exp(_row_col(lnT, st, k)) - Ts_row), Ts
+    if Ts < 0.0:  # near the start: both ends from the same interpolant
+        Ts = t_of_z(pr, st, vinf, zs)
+    return tau * (t_of_z(pr, st, vinf, z) - Ts), Ts
+
+
+@njit(cache=True, inline="always")
+def _u_at(pr, st, vinf, vs, Ts, tt, h):
+    """ū [m] at the reduced time tt = t/τ0 after the start (T(ū) = T(start) + tt)."""
+    if tt == 0.0:
+        return vs * h
+    if tt == math.inf:
+        return vinf * h
+    z = z_of_t(pr, st, vinf, Ts + tt)
+    # ū(t) <= ū(0): the inverse can land an ulp above the start for t → 0; keeps the ODE's
+    # monotonicity (a round-off bound, not a clamp)
+    return min(vinf * (1.0 + math.exp(z)), vs) * h
+
+
 @njit(parallel=True, cache=True)
 def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
     """method="fast": every case from the primitive (fall-back rows by quadrature).
 
     The records are unpacked into plain arrays before the parallel loop, and the per-case
-    work is inline in its body: a call per case with the records by value costs ten times
-    the arithmetic. Ratio targets (same z for every case) come from the row tables ``rt``
-    unless the start lies within GUARD_Z above them; there, and for Δu targets, both ends
-    come from t_of_z (one interpolant: the difference is accurate and >= 0 however close the
-    target is to the start); ū at times from its inverse z_of_t."""
+    work is inline in its body (helpers with ``inline="always"``): a call per case with the
+    records by value costs ten times the arithmetic. Ratio targets (same z for every case)
+    come from the row tables ``rt`` unless the start lies within GUARD_Z above them; there,
+    and for Δu targets, both ends come from t_of_z (one interpolant: the difference is
+    accurate and >= 0 however close the target is to the start); ū at times from its inverse
+    z_of_t."""
     # one field per statement: with tuple unpacking (a, b = rec.a, rec.b) numba 0.6x's parfor
     # lowering keeps only the first array's writes, and a record-field setitem in the loop
     # body (rec.a[i] = x) is lost as well
@@ -153,18 +197,16 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
     R = cs.R
     eta = cs.eta
     us = cs.us
-    ratios = tg.ratios
     dvs = tg.dvs
     times = tg.times
     lnT = rt.lnT
     lnTs = rt.lnTs
     x_lo, x_hi = mp.x_min, min(mp.x_max, x_fast)
-    nT, nU, nr = T_out.shape[0], U_out.shape[0], ratios.size
+    nT, nU, nr = T_out.shape[0], U_out.shape[0], tg.ratios.size
     per_case_times = times.shape[1] > 1
     r1s = np.empty(1 + nr)  # ū/ū∞ - 1 of t_star and the ratios, and its log
     r1s[0] = 0.01
-    for k in range(nr):
-        r1s[k + 1] = ratios[k] - 1.0
+    r1s[1:] = tg.ratios - 1.0
     zr = np.log(r1s)
     for i in prange(p0.size):
         tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
@@ -173,66 +215,29 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
         tau0[i] = tau
         if not (x_lo <= x0 <= x_hi):
             _slow_row(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
-        else:
-            st = stencil(pr, x0)
-            vinf = math.exp(row_value(pr.lnv, st))
-            if not (vs_in != vs_in or vs_in * h > vinf * h):  # as reported (SI)
-                _below_row(vinf, vs_in, h, x0, i, out)
-            else:
-                # Ts: T at the start from t_of_z (-1: not computed yet); Ts_row: the default
-                # start's T from the row table, paired with row-table targets only
-                if vs_in != vs_in:
-                    zs = row_value(pr.zs, st)
-                    vs = vinf * (1.0 + math.exp(zs))
-                    Ts_row = math.exp(row_value(lnTs, st))
-                    Ts = -1.0
-                elif vs_in == math.inf:
-                    zs, vs, Ts = math.inf, vs_in, 0.0
-                    Ts_row = Ts
-                else:
-                    vs = vs_in
-                    zs = math.log(vs / vinf - 1.0)
-                    Ts = t_of_z(pr, st, vinf, zs)
-                    Ts_row = Ts
-                u_inf[i] = vinf * h
-                u_start[i] = vs * h
-                t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
-                u_trap[i] = math.nan
-                t_trap[i] = math.inf
-                flf[i] = 0.0
-                bad = not (0.0 < tau < math.inf)
-                for k in range(nT):
-                    if k <= nr:
-                        r1 = r1s[k]
-                    else:
-                        r1 = dvs[k - 1 - nr] / vinf
-                    if vinf * (1.0 + r1) >= vs:
-                        tk = 0.0
-                    else:
-                        z = zr[k] if k <= nr else math.log(r1)
-                        if k <= nr and z < zs - GUARD_Z:
-                            tk = tau * (math.exp(_row_col(lnT, st, k)) - Ts_row)
-                        else:  # near the start: both ends from the same interpolant
-                            if Ts < 0.0:
-                                Ts = t_of_z(pr, st, vinf, zs)
-                            tk = tau * (t_of_z(pr, st, vinf, z) - Ts)
-                    T_out[k, i] = tk
-                    if tk == math.inf:
-                        bad = True
-                if nU > 0 and Ts < 0.0:
-                    Ts = t_of_z(pr, st, vinf, zs)  # the inverse z_of_t pairs with t_of_z
-                for k in range(nU):
-                    tt = times[k, i if per_case_times else i - i] / tau
-                    if tt == 0.0:
-                        U_out[k, i] = vs * h
-                    elif tt == math.inf:
-                        U_out[k, i] = vinf * h
-                    else:
-                        z = z_of_t(pr, st, vinf, Ts + tt)
-                        # ū(t) <= ū(0): the inverse can land an ulp above the start for
-                        # t → 0; keeps the ODE's monotonicity (a round-off bound, not a clamp)
-                        U_out[k, i] = min(vinf * (1.0 + math.exp(z)), vs) * h
-                status[i] = qk.ST_OVERFLOW if bad else qk.ST_OK
+            continue
+        st = stencil(pr, x0)
+        vinf = math.exp(row_value(pr.lnv, st))
+        if not (vs_in != vs_in or vs_in * h > vinf * h):  # as reported (SI)
+            _below_row(vinf, vs_in, h, x0, i, out)
+            continue
+        zs, vs, Ts, Ts_row = _case_start(pr, st, vinf, vs_in, lnTs)
+        u_inf[i] = vinf * h
+        u_start[i] = vs * h
+        t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
+        u_trap[i] = math.nan
+        t_trap[i] = math.inf
+        flf[i] = 0.0
+        bad = not (0.0 < tau < math.inf)
+        for k in range(nT):
+            tk, Ts = _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, nr, r1s, zr, dvs, lnT)
+            T_out[k, i] = tk
+            bad = bad or tk == math.inf
+        if nU > 0 and Ts < 0.0:
+            Ts = t_of_z(pr, st, vinf, zs)  # the inverse z_of_t pairs with t_of_z
+        for k in range(nU):
+            U_out[k, i] = _u_at(pr, st, vinf, vs, Ts, times[k, i if per_case_times else i - i] / tau, h)
+        status[i] = qk.ST_OVERFLOW if bad else qk.ST_OK
 
 
 @njit(cache=True)
