@@ -20,7 +20,7 @@ from ..contact._kernels import m1_above, u1_at_area
 from ..kernels.quadrature import gauss_kronrod15
 
 __all__ = ["EMTSpec", "critical_junction_kernel", "emt_kernel", "emt_sigma", "bruggeman",
-           "EMT_TOL", "EMT_MAX_PANELS", "EMT_GRADE"]
+           "newton_step", "EMT_TOL", "EMT_MAX_PANELS", "EMT_GRADE"]
 
 
 class EMTSpec(NamedTuple):
@@ -131,6 +131,37 @@ def _node_terms(s, sj, hzj, almqvist, ghx, ghw, kk=1.0):
 
 
 @njit(cache=True)
+def newton_step(y, f, df, lo, hi):
+    """One safeguarded Newton step in y = ln s on a root of f (f increasing in y).
+
+    Parameters
+    ----------
+    y : float
+        Current iterate [-] (ln of the reduced conductivity).
+    f, df : float
+        Residual at y and its derivative in y [-].
+    lo, hi : float
+        Bracket of the root [-].
+
+    Returns
+    -------
+    (y_new, lo, hi, done)
+        The Newton iterate (the bracket's middle where Newton leaves it), the bracket
+        narrowed by the sign of f, and whether |Δy| <= 1e-15 max(1, |y|) or the bracket
+        is narrower than 1e-15.
+    """
+    if f > 0.0:
+        hi = y
+    else:
+        lo = y
+    yn = y - f / df if df > 0.0 else 0.5 * (lo + hi)
+    if not (lo < yn < hi):
+        yn = 0.5 * (lo + hi)
+    done = abs(yn - y) < 1e-15 * max(1.0, abs(y)) or hi - lo < 1e-15
+    return yn, lo, hi, done
+
+
+@njit(cache=True)
 def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw, guess=0.0, threshold=0.5):
     """Solve Σ_j W_j 2s/(s + σ_j) + 2 A1 - 1 = 0 for s > 0 (2-D Bruggeman, reduced units).
 
@@ -179,16 +210,9 @@ def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw, guess=0.0, threshold=0.5):
             t1, t2 = _node_terms(s, sig[j], hz[j], almqvist, ghx, ghw, kk)
             f += W[j] * t1
             df += W[j] * t2
-        if f > 0.0:
-            hi = y
-        else:
-            lo = y
-        yn = y - f / df if df > 0.0 else 0.5 * (lo + hi)
-        if not (lo < yn < hi):
-            yn = 0.5 * (lo + hi)
-        if abs(yn - y) < 1e-15 * max(1.0, abs(y)) or hi - lo < 1e-15:
-            return math.exp(yn)
-        y = yn
+        y, lo, hi, done = newton_step(y, f, df, lo, hi)
+        if done:
+            break
     return math.exp(y)
 
 

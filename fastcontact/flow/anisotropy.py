@@ -34,26 +34,24 @@ doi:10.1115/1.3254641.
 from __future__ import annotations
 
 import math
-import threading
-import weakref
+import time
 
 import numpy as np
-from numba import njit, prange
 from scipy.interpolate import CubicSpline
-from scipy.special import erf
 
-from .._core.validate import check_positive, check_range
-from ..contact import area_fraction, percolation_pressure
-from ..contact._kernels import PANEL, psd_kernel, u1_at_area
-from ..kernels.quadrature import gauss_legendre
-from ..kernels.special import k_table
-from .conductivity import check_emt_threshold, check_theory, conductivity
+from .._core.cache import PerObjectCache
+from .._core.validate import check_positive
+from ..contact import percolation_pressure
+from .directional import (FORMS, N_PANELS, _check, check_anisotropy, directional_sigma_bar,
+                          directional_threshold, sigma_directional)
 
 __all__ = [
     "FORMS",
     "N_PANELS",
     "DirectionalTable",
     "directional_sigma_bar",
+    "directional_threshold",
+    "check_anisotropy",
     "precompute_directional",
     "directional_tables",
     "directional_columns",
@@ -62,242 +60,6 @@ __all__ = [
     "sigma_directional",
     "DIRECTIONAL_STEMS",
 ]
-
-FORMS = ("self_consistent", "fixed")
-#: composite Gauss–Legendre panels (order 10) in the graded variable t of A (see Notes)
-N_PANELS = 48
-GL_ORDER = 10
-GRADE = 3.0
-
-
-# =========================================================================== Bruggeman
-@njit(cache=True)
-def _residual(s, W, sig, A1, lam):
-    """Σ W (1+λ)s/(λs + σ_j) + A1(1+λ)/λ - 1 and its derivative in ln s."""
-    f = A1 * (1.0 + lam) / lam - 1.0
-    df = 0.0
-    for j in range(W.size):
-        if W[j] == 0.0:
-            continue
-        d = lam * s + sig[j]
-        f += W[j] * (1.0 + lam) * s / d
-        df += W[j] * (1.0 + lam) * (s / d) * (sig[j] / d)
-    return f, df
-
-
-@njit(cache=True)
-def _solve_dir(W, sig, A1, lam):
-    """σ̄ with ∫P (σ - s)/(λ s + σ) = 0 (depolarization 1/(1+λ)); 0 if A1 >= λ/(1+λ)."""
-    if A1 >= lam / (1.0 + lam):
-        return 0.0
-    smax = 0.0
-    for j in range(sig.size):
-        smax = max(smax, sig[j])
-    lo = -700.0
-    hi = math.log(smax) + 2.0 + math.log(1.0 + 1.0 / lam)
-    y = 0.5 * (lo + hi)
-    for _ in range(300):
-        f, df = _residual(math.exp(y), W, sig, A1, lam)
-        if f > 0.0:
-            hi = y
-        else:
-            lo = y
-        yn = y - f / df if df > 0.0 else 0.5 * (lo + hi)
-        if not (lo < yn < hi):
-            yn = 0.5 * (lo + hi)
-        if abs(yn - y) < 1e-15 * max(1.0, abs(y)) or hi - lo < 1e-15:
-            return math.exp(yn)
-        y = yn
-    return math.exp(y)
-
-
-@njit(cache=True)
-def _solve_self_consistent(W, sig, A1, gam, kk=1.0):
-    """(σ̄_xx, σ̄_yy) with Λ = γ √(σ_yy/σ_xx) found by bisection in ln Λ.
-
-    The x equation has λ = kk Λ, the y equation λ = kk/Λ; kk = A_c/(1 - A_c) is the odds of
-    the tables' effective-medium threshold A_c (1 for the 2-D Bruggeman A_c = 1/2), so both
-    close together at A(ζ1)/A0 = A_c (Λ = 1 there) for every γ_T.
-    """
-    if A1 >= kk / (1.0 + kk):
-        return 0.0, 0.0
-    lk = math.log(kk)
-    l0 = math.log(A1 / (1.0 - A1)) if A1 > 0.0 else -60.0 - abs(lk)
-    lo = l0 - lk
-    hi = -l0 + lk
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        lam = math.exp(mid)
-        sx = _solve_dir(W, sig, A1, kk * lam)
-        sy = _solve_dir(W, sig, A1, kk / lam)
-        if sx <= 0.0:
-            lo = mid
-            continue
-        if sy <= 0.0:
-            hi = mid
-            continue
-        h = mid - math.log(gam) - 0.5 * (math.log(sy) - math.log(sx))
-        if h > 0.0:
-            hi = mid
-        else:
-            lo = mid
-        if hi - lo < 1e-14:
-            return sx, sy
-    lam = math.exp(0.5 * (lo + hi))
-    return _solve_dir(W, sig, A1, kk * lam), _solve_dir(W, sig, A1, kk / lam)
-
-
-# =========================================================================== P(u) nodes
-@njit(cache=True, parallel=True)
-def _u1_nodes(sk, pbar, area, gamma, ktab, glx, glw, panel, out):
-    """out[i, j] = (u1 at A(ζ)/A0 = area[i, j], pressure pbar[i]) [m]; inf where masked."""
-    n, m = area.shape
-    for k in prange(n * m):
-        i = k // m
-        j = k - i * m
-        work = np.empty(4)
-        u, _a = u1_at_area(sk, area[i, j], pbar[i], gamma, ktab, glx, glw, panel, work)
-        out[i, j] = u
-
-
-def _nodes(psd, pbar, gamma, n_panels):
-    """(W, σ̄ = (u1/h)³, A1) per pressure (rows): the u1-based P(u) of the Bruggeman medium
-    on graded Gauss–Legendre nodes in A ∈ [A(ζ1), 1] (masked u1 → zero weight).
-
-    u1 is evaluated where A(ζ)/A0 equals each node *exactly* (contact core's u1_at_area):
-    at low pressure A(ζ) falls within ζ - 1 ~ (p/E*)² < 1e-16, where ζ is not representable.
-    """
-    A1 = erf(pbar / (2.0 * math.sqrt(0.25 * math.pi * psd.cum3[-1])))
-    x, w = np.polynomial.legendre.leggauss(GL_ORDER)
-    edges = np.linspace(0.0, 1.0, n_panels + 1)
-    half = 0.5 * np.diff(edges)
-    t = (0.5 * (edges[:-1] + edges[1:])[:, None] + half[:, None] * x[None, :]).ravel()
-    wt = (half[:, None] * w[None, :]).ravel()
-    m = GRADE
-    tm, om = t ** m, (1.0 - t) ** m
-    s = tm / (tm + om)
-    ds = m * (t * (1.0 - t)) ** (m - 1.0) / (tm + om) ** 2
-    area = A1[:, None] + (1.0 - A1[:, None]) * s[None, :]
-    W = (1.0 - A1[:, None]) * (ds * wt)[None, :]
-    ok = (area > A1[:, None]) & (area < 1.0)
-    glx, glw = gauss_legendre()
-    u = np.empty(area.shape)
-    _u1_nodes(psd_kernel(psd), np.ascontiguousarray(pbar), np.ascontiguousarray(
-        np.where(ok, area, 0.5)), float(gamma), k_table(), glx, glw, float(PANEL), u)
-    with np.errstate(over="ignore", invalid="ignore"):
-        sig = (np.maximum(u, 0.0) / psd.h_rms) ** 3
-    bad = ~ok | ~np.isfinite(sig)
-    return (np.ascontiguousarray(np.where(bad, 0.0, W)),
-            np.ascontiguousarray(np.where(bad, 0.0, sig)), A1)
-
-
-def _odds(emt_threshold):
-    """kk = A_c/(1 - A_c) of an effective-medium threshold A_c (1 for A_c = 1/2)."""
-    a = float(check_emt_threshold(emt_threshold))
-    return 1.0 if a == 0.5 else a / (1.0 - a)
-
-
-def directional_sigma_bar(psd, pbar, anisotropy, *, form="self_consistent", gamma=1.0,
-                          n_panels=N_PANELS, emt_threshold=0.5):
-    """(σ̄_xx, σ̄_yy) = 12ησ/h_rms³ [-] of the anisotropic Bruggeman medium at p̄ = p/E*.
-
-    Always runs the anisotropic solver (also at γ_T = 1; used to test continuity).
-    ``emt_threshold`` A_c [-] is the isotropic medium's percolation threshold (0.5: 2-D
-    Bruggeman; a calibrated value as in :func:`~fastcontact.flow.conductivity.conductivity`):
-    the depolarization odds (1 - n)/n become kk γ_T^{±1} ("fixed") or kk Λ^{±1}
-    ("self_consistent"), kk = A_c/(1 - A_c), so that γ_T = 1 is the generalized isotropic
-    medium and the self-consistent thresholds stay at A_c.
-    """
-    pbar = np.atleast_1d(np.asarray(pbar, dtype=np.float64)).ravel()
-    sx = np.empty(pbar.size)
-    sy = np.empty(pbar.size)
-    W, sig, A1 = _nodes(psd, pbar, gamma, int(n_panels))
-    g = float(anisotropy)
-    kk = _odds(emt_threshold)
-    for i in range(pbar.size):
-        if form == "self_consistent":
-            sx[i], sy[i] = _solve_self_consistent(W[i], sig[i], float(A1[i]), g, kk)
-        else:
-            sx[i] = _solve_dir(W[i], sig[i], float(A1[i]), kk * g)
-            sy[i] = _solve_dir(W[i], sig[i], float(A1[i]), kk / g)
-    return sx, sy
-
-
-def _check(theory, anisotropy, direction, form):
-    check_theory(theory)
-    g = float(check_range("anisotropy", anisotropy, 1.0, math.inf, "[-] (Peklenik number "
-                          "γ_T = ξ_x/ξ_y >= 1; put the long correlation length along x)",
-                          hi_open=True))
-    if direction not in ("x", "y"):
-        raise ValueError(f"direction = {direction!r} is invalid: must be 'x' (along the long "
-                         f"correlation length) or 'y'")
-    if form not in FORMS:
-        raise ValueError(f"form = {form!r} is invalid: must be one of {list(FORMS)}")
-    if theory == "critical_junction" and form != "fixed" and g != 1.0:
-        raise ValueError("form = 'self_consistent' is invalid with theory = "
-                         "'critical_junction': the directional junction is defined for "
-                         "form = 'fixed' (directional percolation thresholds) only")
-    return g
-
-
-def directional_threshold(a_perc, anisotropy, direction):
-    """Directional percolation area fraction of the 'fixed' form: odds scaled by γ_T^{±1}."""
-    g = anisotropy if direction == "x" else 1.0 / anisotropy
-    return g * a_perc / (1.0 - a_perc + g * a_perc)
-
-
-def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, direction="x", *,
-                      form="self_consistent", gamma=1.0, a_perc=0.5, alpha_cj=1.0,
-                      n_panels=N_PANELS, emt_threshold=0.5):
-    """Directional interfacial conductivity σ_xx or σ_yy [m³/(Pa·s)] by direct quadrature.
-
-    Parameters
-    ----------
-    psd : PSD
-        Angle-averaged roughness spectrum (Persson convention).
-    p : array_like
-        Contact pressure p_cont [Pa], > 0.
-    E_star : float
-        Effective modulus [Pa], > 0.
-    eta : float
-        Fluid viscosity [Pa·s], > 0.
-    theory : {"emt", "critical_junction", "average"}
-        Flow theory (module docstring).
-    anisotropy : float
-        Peklenik/Tripp number γ_T = ξ_x/ξ_y >= 1 [-]; 1 = isotropic (exactly the
-        isotropic :func:`~fastcontact.flow.conductivity.conductivity`).
-    direction : {"x", "y"}
-        Flow along the long correlation length ("x", the grooves) or across it ("y").
-    form : {"self_consistent", "fixed"}
-        Depolarization factors in the anisotropic effective medium or in an isotropic host.
-    gamma, a_perc, alpha_cj, emt_threshold :
-        As in :func:`~fastcontact.flow.conductivity.conductivity` (``a_perc``: the critical
-        junction's isotropic threshold; ``emt_threshold``: the effective medium's).
-    n_panels : int
-        Gauss–Legendre panels (order 10) of the P(u) quadrature in A (EMT).
-
-    Returns
-    -------
-    (sigma [m³/(Pa·s)], percolated [bool]) arrays of p's shape.
-    """
-    g = _check(theory, anisotropy, direction, form)
-    p = check_positive("p", p, "[Pa]")
-    E_star = float(check_positive("E_star", E_star, "[Pa]"))
-    eta = float(check_positive("eta", eta, "[Pa·s]"))
-    a_c = float(check_emt_threshold(emt_threshold))
-    if g == 1.0 or theory == "average":
-        return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_perc,
-                            alpha_cj=alpha_cj, emt_threshold=a_c)
-    if theory == "critical_junction":
-        a_dir = directional_threshold(float(a_perc), g, direction)
-        return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_dir,
-                            alpha_cj=alpha_cj)
-    sx, sy = directional_sigma_bar(psd, np.ravel(p) / E_star, g, form=form, gamma=gamma,
-                                   n_panels=n_panels, emt_threshold=a_c)
-    sb = (sx if direction == "x" else sy).reshape(np.shape(p))
-    a_thr = a_c if form == "self_consistent" else directional_threshold(a_c, g, direction)
-    perc = np.asarray(area_fraction(psd, p, E_star)) >= a_thr
-    return sb * psd.h_rms ** 3 / (12.0 * eta), perc
 
 
 # =========================================================================== table path
@@ -376,8 +138,6 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
     -------
     DirectionalTable
     """
-    import time
-
     t0 = time.perf_counter()
     g = _check("emt", anisotropy, "x", form)
     psd = tables.surface
@@ -497,28 +257,25 @@ def _tables_with(tables, keep, data, perc_emt, options, extra_info):
     return Tables(tables.surface, keep, options, tables.grid, tables.zeta_grid, data, info)
 
 
-_VIEWS = weakref.WeakKeyDictionary()
-_VIEWS_LOCK = threading.Lock()
+_VIEWS = PerObjectCache()
 
 
 def _stored_view(tables, direction):
     """The one-direction :class:`Tables` of tables that store both directions (cached per
     parent object, so the engines' per-Tables caches are reused across calls)."""
-    with _VIEWS_LOCK:
-        per = _VIEWS.get(tables)
-        if per is None:
-            per = {}
-            _VIEWS[tables] = per
-        if direction not in per:
-            keep = [t for t in tables.theories if t in ("average", "emt")]
-            data = _drop_theories(tables, keep)
-            for k in DIRECTIONAL_STEMS:
-                data[k] = tables.data[f"{k}_{direction}"]
-            d_info = tables.info.get("directional", {})
-            perc = float(d_info["percolation_p_over_E"][direction])
-            options = dict(tables.options, direction=direction)
-            per[direction] = _tables_with(tables, keep, data, perc, options, {})
-        return per[direction]
+    return _VIEWS.get(tables, direction, lambda: _build_view(tables, direction))
+
+
+def _build_view(tables, direction):
+    """The ``direction`` view of tables that store both directions (uncached)."""
+    keep = [t for t in tables.theories if t in ("average", "emt")]
+    data = _drop_theories(tables, keep)
+    for k in DIRECTIONAL_STEMS:
+        data[k] = tables.data[f"{k}_{direction}"]
+    d_info = tables.info.get("directional", {})
+    perc = float(d_info["percolation_p_over_E"][direction])
+    options = dict(tables.options, direction=direction)
+    return _tables_with(tables, keep, data, perc, options, {})
 
 
 def tables_for_direction(tables, direction, theory=None):

@@ -18,11 +18,13 @@ arXiv:1004.1037 and Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019.
 from __future__ import annotations
 
 import contextlib
+import math
 from typing import NamedTuple, Optional
 
 import numpy as np
 from numba import get_parallel_chunksize, set_parallel_chunksize
 
+from .._core.docs import fill_params
 from .._core.validate import check_positive, check_range
 from .._core.vocab import DEFAULT_THEORY, THEORIES
 from ..contact import _check_gamma, _check_psd, _separation, mean_separation
@@ -31,7 +33,7 @@ from ..kernels.quadrature import gauss_hermite, gauss_legendre
 from ..kernels.special import k_table
 from ._kernels import EMT_TOL, EMTSpec, critical_junction_kernel, emt_kernel
 
-__all__ = ["THEORIES", "EMT_TOL", "check_theory", "check_emt_threshold", "conductivity", "flow_factor", "sigma_bar",
+__all__ = ["THEORIES", "EMT_TOL", "check_theory", "check_emt_threshold", "check_anisotropy", "conductivity", "flow_factor", "sigma_bar",
            "SigmaBar", "SigmaDetails", "Conductivity", "FlowFactor"]
 
 #: initial Gauss–Kronrod panels of the adaptive effective-medium integral over A
@@ -111,6 +113,13 @@ def check_emt_threshold(emt_threshold):
                              lo_open=True, hi_open=True))
 
 
+def check_anisotropy(anisotropy):
+    """The Peklenik number γ_T = ξ_x/ξ_y >= 1 [-] as a float, or ValueError naming it."""
+    return float(check_range("anisotropy", anisotropy, 1.0, math.inf, "[-] (Peklenik number "
+                             "γ_T = ξ_x/ξ_y >= 1; put the long correlation length along x)",
+                             hi_open=True))
+
+
 def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start=EMT_N_START,
               tol=EMT_TOL, almqvist=False, glx=None, glw=None, panel=PANEL, emt_threshold=0.5):
     """Reduced conductivity σ̄ = 12ησ_eff/h_rms³ [-] at reduced contact pressures p̄ = p/E*.
@@ -164,20 +173,14 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
     return SigmaBar(sig, perc, SigmaDetails(error_estimate=err, u1_evaluations=nev))
 
 
+@fill_params
 def conductivity(psd, p, E_star, eta, theory=DEFAULT_THEORY, *, gamma=1.0, a_perc=0.5,
                  alpha_cj=1.0, tol=EMT_TOL, almqvist=False, emt_threshold=0.5):
     """Effective interfacial fluid conductivity σ_eff(p_cont) [m³/(Pa·s)] by direct quadrature.
 
     Parameters
     ----------
-    psd : PSD
-        Roughness spectrum.
-    p : array_like
-        Contact pressure p_cont [Pa], > 0.
-    E_star : float
-        Effective modulus [Pa], > 0.
-    eta : float
-        Fluid viscosity [Pa·s], > 0.
+    {{psd p_contact E_star_scalar eta}}
     theory : {"average", "critical_junction", "emt"}
         Flow theory (default :data:`~fastcontact._core.vocab.DEFAULT_THEORY`,
         "critical_junction", as everywhere in the package).

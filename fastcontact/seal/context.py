@@ -7,13 +7,12 @@ metadata the Python side needs. Built lazily, once per Tables object and theory,
 from __future__ import annotations
 
 import math
-import threading
 import time
-import weakref
 from typing import NamedTuple
 
 import numpy as np
 
+from .._core.cache import PerObjectCache
 from ..flow.conductivity import check_theory
 from ..tables.build import SIGMA_FLOOR
 from . import _sigma
@@ -234,8 +233,7 @@ class SealContext:
         self.build_seconds = time.perf_counter() - t_start
 
 
-_CONTEXTS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-_CTX_LOCK = threading.Lock()
+_CONTEXTS = PerObjectCache()
 
 
 def seal_context(tables, theory) -> SealContext:
@@ -254,14 +252,7 @@ def seal_context(tables, theory) -> SealContext:
     """
     check_theory(theory)
     tables._need(theory)
-    with _CTX_LOCK:
-        per = _CONTEXTS.get(tables)
-        if per is None:
-            per = {}
-            _CONTEXTS[tables] = per
-        if theory not in per:
-            per[theory] = SealContext(tables, theory)
-        return per[theory]
+    return _CONTEXTS.get(tables, theory, lambda: SealContext(tables, theory))
 
 
 # =========================================================================== soft-seal solver

@@ -15,7 +15,8 @@ import numpy as np
 from .._core.validate import check_positive, check_range
 from .._core.vocab import THEORIES
 from ..contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
-from ..flow.conductivity import EMT_TOL, check_emt_threshold, check_theory, sigma_bar
+from ..flow.conductivity import (EMT_TOL, check_anisotropy, check_emt_threshold, check_theory,
+                                 sigma_bar)
 from ..kernels.hermite import quintic_np
 from ..kernels.locate import Grid
 from ..surface.psd import PSD
@@ -436,9 +437,7 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
 
 def _check_anisotropy(anisotropy, form, theories, options):
     """None for isotropic tables (γ_T = 1), else (γ_T, form); ValueError naming the problem."""
-    g = float(check_range("anisotropy", anisotropy, 1.0, math.inf, "[-] (Peklenik number "
-                          "γ_T = ξ_x/ξ_y >= 1; put the long correlation length along x)",
-                          hi_open=True))
+    g = check_anisotropy(anisotropy)
     if form not in ("self_consistent", "fixed"):
         raise ValueError(f"anisotropy_form = {form!r} is invalid: must be 'self_consistent' or "
                          f"'fixed'")

@@ -1,0 +1,177 @@
+"""Directional conductivities σ_xx, σ_yy of anisotropic roughness by direct quadrature.
+
+The anisotropic 2-D Bruggeman medium on the u1-based P(u) of the angle-averaged spectrum
+(:func:`directional_sigma_bar`), its validating wrapper in SI units
+(:func:`sigma_directional`) and the directional percolation thresholds of the "fixed" form
+(:func:`directional_threshold`). The model (forms, thresholds, the critical junction per
+direction) is described in :mod:`fastcontact.flow.anisotropy`, which re-exports every name
+here; the table path (σ̄_xx, σ̄_yy splines and table views) lives there.
+
+References: B.N.J. Persson, J. Phys.: Condens. Matter 22, 265004 (2010),
+doi:10.1088/0953-8984/22/26/265004; D. Stroud, Phys. Rev. B 12, 3368 (1975),
+doi:10.1103/PhysRevB.12.3368.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.special import erf
+
+from .._core.docs import fill_params
+from .._core.validate import check_positive
+from ..contact import area_fraction
+from ..contact._kernels import PANEL, psd_kernel
+from ..kernels.quadrature import gauss_legendre
+from ..kernels.special import k_table
+from ._anisotropic_kernels import solve_dir, solve_self_consistent, u1_nodes
+from .conductivity import check_anisotropy, check_emt_threshold, check_theory, conductivity
+
+__all__ = [
+    "FORMS",
+    "N_PANELS",
+    "check_anisotropy",
+    "directional_sigma_bar",
+    "directional_threshold",
+    "sigma_directional",
+]
+
+FORMS = ("self_consistent", "fixed")
+#: composite Gauss–Legendre panels (order 10) in the graded variable t of A (see Notes)
+N_PANELS = 48
+GL_ORDER = 10
+GRADE = 3.0
+
+
+def _nodes(psd, pbar, gamma, n_panels):
+    """(W, σ̄ = (u1/h)³, A1) per pressure (rows): the u1-based P(u) of the Bruggeman medium
+    on graded Gauss–Legendre nodes in A ∈ [A(ζ1), 1] (masked u1 → zero weight).
+
+    u1 is evaluated where A(ζ)/A0 equals each node *exactly* (contact core's u1_at_area):
+    at low pressure A(ζ) falls within ζ - 1 ~ (p/E*)² < 1e-16, where ζ is not representable.
+    """
+    A1 = erf(pbar / (2.0 * math.sqrt(0.25 * math.pi * psd.cum3[-1])))
+    x, w = np.polynomial.legendre.leggauss(GL_ORDER)
+    edges = np.linspace(0.0, 1.0, n_panels + 1)
+    half = 0.5 * np.diff(edges)
+    t = (0.5 * (edges[:-1] + edges[1:])[:, None] + half[:, None] * x[None, :]).ravel()
+    wt = (half[:, None] * w[None, :]).ravel()
+    m = GRADE
+    tm, om = t ** m, (1.0 - t) ** m
+    s = tm / (tm + om)
+    ds = m * (t * (1.0 - t)) ** (m - 1.0) / (tm + om) ** 2
+    area = A1[:, None] + (1.0 - A1[:, None]) * s[None, :]
+    W = (1.0 - A1[:, None]) * (ds * wt)[None, :]
+    ok = (area > A1[:, None]) & (area < 1.0)
+    glx, glw = gauss_legendre()
+    u = np.empty(area.shape)
+    u1_nodes(psd_kernel(psd), np.ascontiguousarray(pbar), np.ascontiguousarray(
+        np.where(ok, area, 0.5)), float(gamma), k_table(), glx, glw, float(PANEL), u)
+    with np.errstate(over="ignore", invalid="ignore"):
+        sig = (np.maximum(u, 0.0) / psd.h_rms) ** 3
+    bad = ~ok | ~np.isfinite(sig)
+    return (np.ascontiguousarray(np.where(bad, 0.0, W)),
+            np.ascontiguousarray(np.where(bad, 0.0, sig)), A1)
+
+
+def _odds(emt_threshold):
+    """kk = A_c/(1 - A_c) of an effective-medium threshold A_c (1 for A_c = 1/2)."""
+    a = float(check_emt_threshold(emt_threshold))
+    return 1.0 if a == 0.5 else a / (1.0 - a)
+
+
+def directional_sigma_bar(psd, pbar, anisotropy, *, form="self_consistent", gamma=1.0,
+                          n_panels=N_PANELS, emt_threshold=0.5):
+    """(σ̄_xx, σ̄_yy) = 12ησ/h_rms³ [-] of the anisotropic Bruggeman medium at p̄ = p/E*.
+
+    Always runs the anisotropic solver (also at γ_T = 1; used to test continuity).
+    ``emt_threshold`` A_c [-] is the isotropic medium's percolation threshold (0.5: 2-D
+    Bruggeman; a calibrated value as in :func:`~fastcontact.flow.conductivity.conductivity`):
+    the depolarization odds (1 - n)/n become kk γ_T^{±1} ("fixed") or kk Λ^{±1}
+    ("self_consistent"), kk = A_c/(1 - A_c), so that γ_T = 1 is the generalized isotropic
+    medium and the self-consistent thresholds stay at A_c.
+    """
+    pbar = np.atleast_1d(np.asarray(pbar, dtype=np.float64)).ravel()
+    sx = np.empty(pbar.size)
+    sy = np.empty(pbar.size)
+    W, sig, A1 = _nodes(psd, pbar, gamma, int(n_panels))
+    g = float(anisotropy)
+    kk = _odds(emt_threshold)
+    for i in range(pbar.size):
+        if form == "self_consistent":
+            sx[i], sy[i] = solve_self_consistent(W[i], sig[i], float(A1[i]), g, kk)
+        else:
+            sx[i] = solve_dir(W[i], sig[i], float(A1[i]), kk * g)
+            sy[i] = solve_dir(W[i], sig[i], float(A1[i]), kk / g)
+    return sx, sy
+
+
+def _check(theory, anisotropy, direction, form):
+    check_theory(theory)
+    g = check_anisotropy(anisotropy)
+    if direction not in ("x", "y"):
+        raise ValueError(f"direction = {direction!r} is invalid: must be 'x' (along the long "
+                         f"correlation length) or 'y'")
+    if form not in FORMS:
+        raise ValueError(f"form = {form!r} is invalid: must be one of {list(FORMS)}")
+    if theory == "critical_junction" and form != "fixed" and g != 1.0:
+        raise ValueError("form = 'self_consistent' is invalid with theory = "
+                         "'critical_junction': the directional junction is defined for "
+                         "form = 'fixed' (directional percolation thresholds) only")
+    return g
+
+
+def directional_threshold(a_perc, anisotropy, direction):
+    """Directional percolation area fraction of the 'fixed' form: odds scaled by γ_T^{±1}."""
+    g = anisotropy if direction == "x" else 1.0 / anisotropy
+    return g * a_perc / (1.0 - a_perc + g * a_perc)
+
+
+@fill_params
+def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, direction="x", *,
+                      form="self_consistent", gamma=1.0, a_perc=0.5, alpha_cj=1.0,
+                      n_panels=N_PANELS, emt_threshold=0.5):
+    """Directional interfacial conductivity σ_xx or σ_yy [m³/(Pa·s)] by direct quadrature.
+
+    Parameters
+    ----------
+    psd : PSD
+        Angle-averaged roughness spectrum (Persson convention).
+    {{p_contact E_star_scalar eta}}
+    theory : {"emt", "critical_junction", "average"}
+        Flow theory (module docstring).
+    anisotropy : float
+        Peklenik/Tripp number γ_T = ξ_x/ξ_y >= 1 [-]; 1 = isotropic (exactly the
+        isotropic :func:`~fastcontact.flow.conductivity.conductivity`).
+    direction : {"x", "y"}
+        Flow along the long correlation length ("x", the grooves) or across it ("y").
+    form : {"self_consistent", "fixed"}
+        Depolarization factors in the anisotropic effective medium or in an isotropic host.
+    gamma, a_perc, alpha_cj, emt_threshold :
+        As in :func:`~fastcontact.flow.conductivity.conductivity` (``a_perc``: the critical
+        junction's isotropic threshold; ``emt_threshold``: the effective medium's).
+    n_panels : int
+        Gauss–Legendre panels (order 10) of the P(u) quadrature in A (EMT).
+
+    Returns
+    -------
+    (sigma [m³/(Pa·s)], percolated [bool]) arrays of p's shape.
+    """
+    g = _check(theory, anisotropy, direction, form)
+    p = check_positive("p", p, "[Pa]")
+    E_star = float(check_positive("E_star", E_star, "[Pa]"))
+    eta = float(check_positive("eta", eta, "[Pa·s]"))
+    a_c = float(check_emt_threshold(emt_threshold))
+    if g == 1.0 or theory == "average":
+        return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_perc,
+                            alpha_cj=alpha_cj, emt_threshold=a_c)
+    if theory == "critical_junction":
+        a_dir = directional_threshold(float(a_perc), g, direction)
+        return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_dir,
+                            alpha_cj=alpha_cj)
+    sx, sy = directional_sigma_bar(psd, np.ravel(p) / E_star, g, form=form, gamma=gamma,
+                                   n_panels=n_panels, emt_threshold=a_c)
+    sb = (sx if direction == "x" else sy).reshape(np.shape(p))
+    a_thr = a_c if form == "self_consistent" else directional_threshold(a_c, g, direction)
+    perc = np.asarray(area_fraction(psd, p, E_star)) >= a_thr
+    return sb * psd.h_rms ** 3 / (12.0 * eta), perc
