@@ -15,6 +15,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from .powerlaw import seg_moment_np
+
 __all__ = ["QuadRule", "gauss_legendre", "gauss_kronrod15", "gauss_hermite", "seg_moment",
            "seg_moment_np", "GL_ORDER"]
 
@@ -109,15 +111,3 @@ def seg_moment(ci, qs, ei, n, a, lr):
     if abs(k) < 1e-12:
         return pref * lr
     return pref * math.expm1(k * lr) / k
-
-
-def seg_moment_np(c, qs, e, n, a, b):
-    """NumPy twin of :func:`seg_moment` with limits ``a``, ``b`` [1/m] (broadcasts)."""
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    k = n + e + 1.0
-    lr = np.log(b / a)
-    pref = c * (a / qs) ** e * a ** (n + 1.0)
-    if abs(k) < 1e-12:
-        return pref * lr
-    return pref * np.expm1(k * lr) / k

@@ -31,21 +31,9 @@ import numpy as np
 
 from .._core.validate import as_float_array, check_positive, check_range
 from .._core.vocab import CONVENTIONS
+from ..kernels.powerlaw import seg_moment_np
 
 __all__ = ["PSD", "SelfAffinePSD", "TabulatedPSD", "CONVENTIONS", "psd_from_dict"]
-
-
-
-def _segment_moment(c, qs, e, n, a, b):
-    """∫_a^b q^n c (q/qs)^e dq for a power-law segment, cancellation-free for b ≈ a."""
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    k = n + e + 1.0
-    lr = np.log(b / a)
-    pref = c * (a / qs) ** e * a ** (n + 1.0)
-    if abs(k) < 1e-12:
-        return pref * lr
-    return pref * np.expm1(k * lr) / k
 
 
 class PSD:
@@ -73,8 +61,8 @@ class PSD:
     def _cumulative(self, n):
         out = np.zeros(self.qb.size)
         for i in range(self.c.size):
-            out[i + 1] = out[i] + float(_segment_moment(self.c[i], self.qb[i], self.e[i], n,
-                                                        self.qb[i], self.qb[i + 1]))
+            out[i + 1] = out[i] + float(seg_moment_np(self.c[i], self.qb[i], self.e[i], n,
+                                                      self.qb[i], self.qb[i + 1]))
         return out
 
     # ------------------------------------------------------------------ basic properties
@@ -122,7 +110,7 @@ class PSD:
             hi = np.clip(b_arr, self.qb[i], self.qb[i + 1])
             m = hi > lo
             if np.any(m):
-                out[m] += _segment_moment(self.c[i], self.qb[i], self.e[i], float(n), lo[m], hi[m])
+                out[m] += seg_moment_np(self.c[i], self.qb[i], self.e[i], float(n), lo[m], hi[m])
         return out if out.ndim else float(out)
 
     def h_rms_above(self, zeta):

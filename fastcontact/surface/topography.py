@@ -366,6 +366,15 @@ def _check_parseval(psd, h2):
 
 
 # ============================================================================ public API
+def _scans_psd(h, spacing, n_bins, window, detrend):
+    """(TabulatedPSD, mean square height [m²]) of line scans: the rows of ``h`` (or ``h`` itself
+    if 1-D), their averaged 1-D spectrum converted by :func:`~fastcontact.surface.abel.abel_fit`."""
+    rows = h[None, :] if h.ndim == 1 else h
+    a = spacing if np.ndim(spacing) == 0 else spacing[1]
+    q, d, w, h2 = _spectrum_1d(rows, a, n_bins, window, detrend)
+    return TabulatedPSD(q, abel_fit(q, d, w), convention="persson"), h2
+
+
 def psd_from_heights(heights, spacing=None, *, n_bins=None, window="auto", periodic=None,
                      line_scans=False, detrend="mean"):
     """The isotropic Persson-convention spectrum C(q) [m^4] of measured or synthetic heights.
@@ -436,10 +445,7 @@ def psd_from_heights(heights, spacing=None, *, n_bins=None, window="auto", perio
     win = _resolve_window(window, periodic)
     _note_window(win, window, source)
     if h.ndim == 1 or scans:
-        rows = h[None, :] if h.ndim == 1 else h
-        a = spacing if np.ndim(spacing) == 0 else spacing[1]
-        q, d, w, h2 = _spectrum_1d(rows, a, n_bins, win, detrend)
-        psd = TabulatedPSD(q, abel_fit(q, d, w), convention="persson")
+        psd, h2 = _scans_psd(h, spacing, n_bins, win, detrend)
     else:
         psd, h2 = _map_psd(h, spacing, n_bins, win, detrend)
         _check_parseval(psd, h2)
