@@ -213,28 +213,23 @@ def count_cases(axes, combine="product") -> int:
 
 
 # ------------------------------------------------------------------ the former scene API
-_LEGACY = {
-    "load_scene": "fastcontact.studies.load", "available_figures": "fastcontact.studies.load",
-    "STUDY_KINDS": "fastcontact.studies.schema", "SCHEMA": "fastcontact.studies.schema",
-    "SURFACE_KEYS": "fastcontact.studies.schema", "AXIS_KEYS": "fastcontact.studies.schema",
-    "parse_quantity": "fastcontact._core.units", "parse_unit": "fastcontact._core.units",
-    "UnitError": "fastcontact._core.units", "DIMENSIONS": "fastcontact._core.units",
-    "UNIT_EXAMPLES": "fastcontact._core.units",
-    "default_table_path": "fastcontact.studies.examples",
-    "example_scene_path": "fastcontact.studies.examples",
-    "list_example_scenes": "fastcontact.studies.examples",
-    "table_cache_dir": "fastcontact.tables.cache", "obtain_tables": "fastcontact.tables.cache",
-    "build_tables": "fastcontact.tables.cache", "table_key": "fastcontact.tables.cache",
-    "run_scene": "fastcontact.studies.run", "RunResult": "fastcontact.studies.run",
-    "provenance": "fastcontact.studies.run", "PAPER_REFERENCE": "fastcontact.studies.run",
-    "evaluate_cases": "fastcontact.studies.evaluate", "empty_results": "fastcontact.studies.evaluate",
-    "available_columns": "fastcontact.studies.kinds", "squeeze_columns": "fastcontact.studies.kinds",
-    "BOOL_COLUMNS": "fastcontact.studies.kinds", "SEAL_COLUMNS": "fastcontact.studies.kinds",
-    "SEAL_HERTZ_COLUMNS": "fastcontact.studies.kinds", "SQUEEZE_TAIL": "fastcontact.studies.kinds",
-    "write_parquet_atomic": "fastcontact.studies.output",
-    "_atomic_write_bytes": "fastcontact.studies.output",
-    "_json_default": "fastcontact.studies.output",
+#: new module -> the names of the former scene API it now holds
+_LEGACY_HOMES = {
+    "fastcontact.studies.load": ("load_scene", "available_figures"),
+    "fastcontact.studies.schema": ("STUDY_KINDS", "SCHEMA", "SURFACE_KEYS", "AXIS_KEYS"),
+    "fastcontact._core.units": ("parse_quantity", "parse_unit", "UnitError", "DIMENSIONS",
+                                "UNIT_EXAMPLES"),
+    "fastcontact.studies.examples": ("default_table_path", "example_scene_path",
+                                     "list_example_scenes"),
+    "fastcontact.tables.cache": ("table_cache_dir", "obtain_tables", "build_tables", "table_key"),
+    "fastcontact.studies.run": ("run_scene", "RunResult", "provenance", "PAPER_REFERENCE"),
+    "fastcontact.studies.evaluate": ("evaluate_cases", "empty_results"),
+    "fastcontact.studies.kinds": ("available_columns", "squeeze_columns", "BOOL_COLUMNS",
+                                  "SEAL_COLUMNS", "SEAL_HERTZ_COLUMNS", "SQUEEZE_TAIL"),
+    "fastcontact.studies.output": ("write_parquet_atomic", "_atomic_write_bytes",
+                                   "_json_default"),
 }
+_LEGACY = {name: mod for mod, names in _LEGACY_HOMES.items() for name in names}
 
 
 def __getattr__(name):

@@ -15,16 +15,16 @@ from __future__ import annotations
 
 import importlib
 
-_LAZY = {
-    "bem_reference": "bem", "solve_contact": "bem", "surface_realization": "bem",
-    "BEMResolutionWarning": "bem",
-    "reynolds_conductivity": "reynolds",
-    "compare_theories": "compare", "squeeze_time_ratio": "compare",
-    "write_reference": "compare", "read_reference": "compare",
-    "calibrate": "calibration", "Calibration": "calibration",
-    "emt_conductivity": "emt", "emt_sigma_bar": "emt",
-    "comparison_figure": "figures",
+#: submodule -> the names it gives this package (imported on first use)
+_SUBMODULE_NAMES = {
+    "bem": ("bem_reference", "solve_contact", "surface_realization", "BEMResolutionWarning"),
+    "reynolds": ("reynolds_conductivity",),
+    "compare": ("compare_theories", "squeeze_time_ratio", "write_reference", "read_reference"),
+    "calibration": ("calibrate", "Calibration"),
+    "emt": ("emt_conductivity", "emt_sigma_bar"),
+    "figures": ("comparison_figure",),
 }
+_LAZY = {name: mod for mod, names in _SUBMODULE_NAMES.items() for name in names}
 __all__ = sorted(_LAZY)
 
 

@@ -95,6 +95,28 @@ def _e_star(a, ref):
     return float(e)
 
 
+def _read_psd(path, convention=None):
+    """The spectrum in the file ``path`` (:func:`fastcontact.read_psd`)."""
+    from .. import read_psd
+    return read_psd(path, convention)
+
+
+def _read_calibration(path):
+    """The :class:`Calibration` in the file ``path`` (.json, else TOML), or None without one."""
+    if not path:
+        return None
+    from .calibration import Calibration
+    return (Calibration.from_json if path.endswith(".json") else Calibration.from_toml)(path)
+
+
+def _write_table(df, path):
+    """Write ``df`` to ``path``: Parquet if the name ends in .parquet, else CSV (no index)."""
+    if path.lower().endswith(".parquet"):
+        df.to_parquet(path)
+    else:
+        df.to_csv(path, index=False)
+
+
 def _cmd_reference(a, out, err):
     from .. import contact
     from ..psd import SelfAffinePSD
@@ -102,8 +124,7 @@ def _cmd_reference(a, out, err):
     from .compare import write_reference
 
     if a.psd:
-        from .. import read_psd
-        psd = read_psd(a.psd, a.convention)
+        psd = _read_psd(a.psd, a.convention)
     else:
         q0 = a.q0 if a.q0 is not None else 2 * math.pi / 1e-3
         psd = SelfAffinePSD(h_rms=a.h_rms, hurst=a.hurst, q0=q0, q1=a.q1_factor * q0,
@@ -125,19 +146,12 @@ def _cmd_reference(a, out, err):
 
 
 def _cmd_compare(a, out, err):
-    from .calibration import Calibration
     from .compare import compare_theories, read_reference
 
     ref = read_reference(a.reference)
-    cal = None
-    if a.calibration:
-        cal = (Calibration.from_json if a.calibration.endswith(".json")
-               else Calibration.from_toml)(a.calibration)
+    cal = _read_calibration(a.calibration)
     cmp = compare_theories(None, _e_star(a, ref), ref, calibration=cal)
-    if a.output.lower().endswith(".parquet"):
-        cmp.to_parquet(a.output)
-    else:
-        cmp.to_csv(a.output, index=False)
+    _write_table(cmp, a.output)
     for label, s in cmp.attrs["flow_stop"].items():
         print(f"{label:24s} flow stop theory/BEM = {s['ratio']:.3g}", file=out)
     if a.figure:
@@ -155,10 +169,7 @@ def _cmd_calibrate(a, out, err):
     from .compare import read_reference
 
     ref = read_reference(a.reference)
-    psd = None
-    if a.psd:
-        from .. import read_psd
-        psd = read_psd(a.psd)
+    psd = _read_psd(a.psd) if a.psd else None
     cal = calibrate(psd, _e_star(a, ref), ref)
     if a.output.lower().endswith(".json"):
         cal.to_json(a.output)
