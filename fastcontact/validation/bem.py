@@ -265,6 +265,156 @@ def _describe(psd):
         return {"repr": repr(psd)}
 
 
+def _reference_inputs(psd, E_star, p0, n, seeds, eta, box, stop_bisections):
+    """The checked inputs of :func:`bem_reference`: (p [Pa] sorted, E* [Pa], η [Pa·s], n,
+    seeds, box [m], stop_bisections); ImportError without the extra, ValueError if bad."""
+    require_extra()
+    if not hasattr(psd, "q1") or not hasattr(psd, "h_rms"):
+        raise ValueError(f"psd = {psd!r} is invalid: must be a fastcontact PSD object")
+    E_star = _check_pos("E_star", E_star, "[Pa]")
+    eta = _check_pos("eta", eta, "[Pa·s]")
+    n = _check_int("n", n, 16)
+    p = np.sort(np.atleast_1d(np.asarray(p0, dtype=np.float64)).ravel())
+    if p.size == 0 or not np.all(np.isfinite(p)) or np.any(p <= 0):
+        raise ValueError(f"p0 = {p0!r} is invalid: must be finite pressures > 0 [Pa]")
+    seeds = list(np.atleast_1d(seeds))
+    if not seeds:
+        raise ValueError("seeds = [] is invalid: must hold at least one seed")
+    box = 2.0 * math.pi / psd.q0 if box is None else _check_pos("box", box, "[m]")
+    stop_bisections = _check_int("stop_bisections", stop_bisections, 0)
+    return p, E_star, eta, n, seeds, box, stop_bisections
+
+
+def _progress_bar(total, progress):
+    """A tqdm bar of ``total`` solves, or None (``progress`` off, or no tqdm)."""
+    if not progress:
+        return None
+    try:
+        from tqdm.auto import tqdm
+        return tqdm(total=total, desc="BEM reference", unit="solve")
+    except ImportError:
+        return None
+
+
+def _pressure_scan(h, box, E_star, p, eta, find_stop, stop_bisections, bar):
+    """Contact and flow of one realization ``h`` [m] at each pressure of ``p`` [Pa] (ascending,
+    each solve warm-started from the previous one).
+
+    Returns
+    -------
+    rows : (len(p), 4) ndarray
+        A/A0 [-], ū [m], σ_xx and σ_yy [m³/(Pa·s)] per pressure.
+    stop : (float, float)
+        With ``find_stop``, the flow-stop pressure [Pa] bisected between the last flowing and
+        the first blocked pressure and its half log bracket; else (or if the flow never
+        stops) (NaN, NaN).
+    iterations : int
+        Conjugate-gradient iterations of the pressures in ``p`` (not of the bisection).
+    """
+    rows, state, prev, stop, iters = [], None, None, (math.nan, math.nan), 0
+    for k, pk in enumerate(p):
+        c, s = _one_pressure(h, box, E_star, float(pk), eta, state)
+        iters += c["iterations"]
+        flowing = s["x"] > 0.0 or s["y"] > 0.0
+        if find_stop and math.isnan(stop[0]) and not flowing and prev is not None and prev[1]:
+            stop = _flow_stop(h, box, E_star, float(p[k - 1]), float(pk), prev[0], eta,
+                              stop_bisections)
+        prev = (c["state"], flowing)
+        state = c["state"]
+        rows.append((c["area_fraction"], c["u_mean"], s["x"], s["y"]))
+        if bar is not None:
+            bar.update(1)
+    return np.array(rows), stop, iters
+
+
+def _solve_realizations(psd, box, E_star, p, eta, n, jobs, stop_bisections, progress):
+    """Each (grid size, seed) of ``jobs`` solved at every pressure of ``p`` [Pa], with the
+    flow-stop pressure of the n-grid realizations.
+
+    Returns
+    -------
+    results : dict
+        {(grid size, seed): the rows of :func:`_pressure_scan`}.
+    stops : dict
+        {seed: (flow-stop pressure [Pa], half log bracket)} of the n-grid realizations.
+    run : dict
+        ``h_rms_realized`` [m] (rms height of each n-grid realization), ``cg_iterations``
+        and ``seconds`` (wall time of the solves).
+    """
+    bar = _progress_bar(len(jobs) * p.size, progress)
+    t_start = time.perf_counter()
+    results = {}
+    stops = {}
+    h_real = []
+    iters = 0
+    for nn, seed in jobs:
+        h = surface_realization(psd, nn, box, int(seed))
+        if nn == n:
+            h_real.append(float(np.sqrt(np.mean(h ** 2))))
+        results[(nn, seed)], stop, it = _pressure_scan(h, box, E_star, p, eta, nn == n,
+                                                       stop_bisections, bar)
+        iters += it
+        if nn == n:
+            stops[int(seed)] = stop
+    if bar is not None:
+        bar.close()
+    return results, stops, {"h_rms_realized": h_real, "cg_iterations": iters,
+                            "seconds": time.perf_counter() - t_start}
+
+
+def _seed_columns(p, R):
+    """The seed means and standard deviations of the (seeds × pressures × 4) results ``R``
+    (columns of :func:`_pressure_scan`), as the columns of the reference table."""
+    sig = 0.5 * (R[:, :, 2] + R[:, :, 3])
+    ddof = 1 if R.shape[0] > 1 else 0
+    return {
+        "p0": p,
+        "area_fraction": R[:, :, 0].mean(0), "area_fraction_std": R[:, :, 0].std(0, ddof=ddof),
+        "u_mean": R[:, :, 1].mean(0), "u_mean_std": R[:, :, 1].std(0, ddof=ddof),
+        "sigma_eff": sig.mean(0), "sigma_eff_std": sig.std(0, ddof=ddof),
+        "sigma_xx": R[:, :, 2].mean(0), "sigma_yy": R[:, :, 3].mean(0),
+        "n_flowing": (sig > 0).sum(0).astype(np.int64),
+    }
+
+
+def _add_grid_errors(df, units, fine, coarse):
+    """Add the ``*_grid_err`` columns to ``df`` (and their units): the relative difference of
+    the n/2 grid's results ``coarse`` from the n grid's ``fine`` (one seed)."""
+    for j, col in ((0, "area_fraction"), (1, "u_mean")):
+        df[f"{col}_grid_err"] = np.abs(fine[:, j] - coarse[:, j]) / np.abs(fine[:, j])
+    sf = 0.5 * (fine[:, 2] + fine[:, 3])
+    sc = 0.5 * (coarse[:, 2] + coarse[:, 3])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        df["sigma_eff_grid_err"] = np.where(sf > 0, np.abs(sf - sc) / sf, np.nan)
+    for col in ("area_fraction", "u_mean", "sigma_eff"):
+        units[f"{col}_grid_err"] = "1"
+
+
+def _per_seed(rows):
+    """One seed's A/A0 [-], ū [m] and σ_eff [m³/(Pa·s)] per pressure, as lists."""
+    return {"area_fraction": rows[:, 0].tolist(), "u_mean": rows[:, 1].tolist(),
+            "sigma_eff": (0.5 * (rows[:, 2] + rows[:, 3])).tolist()}
+
+
+def _provenance(psd, n, seeds, box, res_info, grid_check, stop_bisections, run):
+    """``attrs["provenance"]`` of a reference: method, grid, seeds, box and pixel [m], PSD,
+    resolution, the solves' record ``run`` (:func:`_solve_realizations`) and versions."""
+    return {
+        "method": "ContactMechanics constrained conjugate gradients (Polonsky-Keer), "
+                  "periodic half-space; Reynolds finite volumes, harmonic face "
+                  "conductance, imposed mean gradient along x and y",
+        "n": n, "seeds": [int(s) for s in seeds], "box": box, "pixel": box / n,
+        "psd": _describe(psd), "psd_h_rms": float(psd.h_rms),
+        "h_rms_realized": run["h_rms_realized"],
+        "pixels_per_wavelength": res_info["pixels_per_wavelength"],
+        "rolloff_modes": res_info["rolloff_modes"],
+        "grid_check_n": n // 2 if grid_check else None,
+        "stop_bisections": stop_bisections,
+        "cg_iterations": run["cg_iterations"], "seconds": run["seconds"],
+        "versions": _versions(),
+    }
+
+
 def bem_reference(psd, E_star, p0, *, n=256, seeds=(0, 1, 2), eta=1e-3, box=None,
                   stop_bisections=4, grid_check=True, progress=True):
     """BEM + Reynolds reference for A/A0, ū and σ_eff versus nominal pressure.
@@ -303,134 +453,44 @@ def bem_reference(psd, E_star, p0, *, n=256, seeds=(0, 1, 2), eta=1e-3, box=None
         ``n_flowing`` (seeds with σ > 0) and, with ``grid_check``, ``*_grid_err``.
         ``attrs`` hold ``units``, ``eta``, ``E_star``, ``flow_stop_pressure`` [Pa] (mean over
         seeds; NaN if flow never stops in the range), ``flow_stop_pressure_std``,
-        ``flow_stop_per_seed``, ``per_seed`` (each seed's columns), ``provenance`` (grid, seeds, box, pixel, psd, versions,
-        resolution, timing) and ``warnings``.
+        ``flow_stop_per_seed``, ``per_seed`` (each seed's columns), ``provenance`` (grid,
+        seeds, box, pixel, psd, versions, resolution, timing) and ``warnings``.
     """
     import pandas as pd
 
-    require_extra()
-    if not hasattr(psd, "q1") or not hasattr(psd, "h_rms"):
-        raise ValueError(f"psd = {psd!r} is invalid: must be a fastcontact PSD object")
-    E_star = _check_pos("E_star", E_star, "[Pa]")
-    eta = _check_pos("eta", eta, "[Pa·s]")
-    n = _check_int("n", n, 16)
-    p = np.sort(np.atleast_1d(np.asarray(p0, dtype=np.float64)).ravel())
-    if p.size == 0 or not np.all(np.isfinite(p)) or np.any(p <= 0):
-        raise ValueError(f"p0 = {p0!r} is invalid: must be finite pressures > 0 [Pa]")
-    seeds = list(np.atleast_1d(seeds))
-    if not seeds:
-        raise ValueError("seeds = [] is invalid: must hold at least one seed")
-    box = 2.0 * math.pi / psd.q0 if box is None else _check_pos("box", box, "[m]")
-    stop_bisections = _check_int("stop_bisections", stop_bisections, 0)
+    p, E_star, eta, n, seeds, box, stop_bisections = _reference_inputs(
+        psd, E_star, p0, n, seeds, eta, box, stop_bisections)
     res_info = resolution_report(psd, n, box)
     for msg in res_info["warnings"]:
         warnings.warn(msg, BEMResolutionWarning, stacklevel=2)
 
     jobs = [(n, s) for s in seeds] + ([(n // 2, seeds[0])] if grid_check else [])
-    total = len(jobs) * p.size
-    bar = None
-    if progress:
-        try:
-            from tqdm.auto import tqdm
-            bar = tqdm(total=total, desc="BEM reference", unit="solve")
-        except ImportError:
-            bar = None
-    t_start = time.perf_counter()
-    results = {}
-    stops = {}
-    h_real = []
-    iters = 0
-    for nn, seed in jobs:
-        h = surface_realization(psd, nn, box, int(seed))
-        if nn == n:
-            h_real.append(float(np.sqrt(np.mean(h ** 2))))
-        rows = []
-        state = None
-        prev = None
-        stop = (math.nan, math.nan)
-        for k, pk in enumerate(p):
-            c, s = _one_pressure(h, box, E_star, float(pk), eta, state)
-            iters += c["iterations"]
-            flowing = s["x"] > 0.0 or s["y"] > 0.0
-            if nn == n and math.isnan(stop[0]) and not flowing and prev is not None \
-                    and prev[1]:
-                stop = _flow_stop(h, box, E_star, float(p[k - 1]), float(pk), prev[0], eta,
-                                  stop_bisections)
-            prev = (c["state"], flowing)
-            state = c["state"]
-            rows.append((c["area_fraction"], c["u_mean"], s["x"], s["y"]))
-            if bar is not None:
-                bar.update(1)
-        results[(nn, seed)] = np.array(rows)
-        if nn == n:
-            stops[int(seed)] = stop
-    if bar is not None:
-        bar.close()
-    elapsed = time.perf_counter() - t_start
+    results, stops, run = _solve_realizations(psd, box, E_star, p, eta, n, jobs,
+                                              stop_bisections, progress)
 
-    R = np.stack([results[(n, s)] for s in seeds])  # seeds × pressures × 4
-    sig = 0.5 * (R[:, :, 2] + R[:, :, 3])
-    ddof = 1 if len(seeds) > 1 else 0
-    df = pd.DataFrame({
-        "p0": p,
-        "area_fraction": R[:, :, 0].mean(0), "area_fraction_std": R[:, :, 0].std(0, ddof=ddof),
-        "u_mean": R[:, :, 1].mean(0), "u_mean_std": R[:, :, 1].std(0, ddof=ddof),
-        "sigma_eff": sig.mean(0), "sigma_eff_std": sig.std(0, ddof=ddof),
-        "sigma_xx": R[:, :, 2].mean(0), "sigma_yy": R[:, :, 3].mean(0),
-        "n_flowing": (sig > 0).sum(0).astype(np.int64),
-    })
-    units = dict(UNITS)
-    for col in ("area_fraction", "u_mean", "sigma_eff"):
-        units[f"{col}_std"] = units[col]
+    df = pd.DataFrame(_seed_columns(p, np.stack([results[(n, s)] for s in seeds])))
+    units = dict(UNITS, **{f"{col}_std": UNITS[col]
+                           for col in ("area_fraction", "u_mean", "sigma_eff")})
     if grid_check:
-        fine = results[(n, seeds[0])]
-        coarse = results[(n // 2, seeds[0])]
-        for j, col in ((0, "area_fraction"), (1, "u_mean")):
-            df[f"{col}_grid_err"] = np.abs(fine[:, j] - coarse[:, j]) / np.abs(fine[:, j])
-        sf = 0.5 * (fine[:, 2] + fine[:, 3])
-        sc = 0.5 * (coarse[:, 2] + coarse[:, 3])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            df["sigma_eff_grid_err"] = np.where(sf > 0, np.abs(sf - sc) / sf, np.nan)
-        for col in ("area_fraction", "u_mean", "sigma_eff"):
-            units[f"{col}_grid_err"] = "1"
+        _add_grid_errors(df, units, results[(n, seeds[0])], results[(n // 2, seeds[0])])
     sv = np.array([stops[int(s)][0] for s in seeds])
     ok = np.isfinite(sv)
-    stop_mean = float(np.exp(np.mean(np.log(sv[ok])))) if ok.any() else math.nan
-    stop_std = float(np.std(sv[ok], ddof=1)) if ok.sum() > 1 else math.nan
     warn = list(res_info["warnings"])
     if not ok.all():
         warn.append(f"flow did not stop below p0 = {p[-1]:.4g} Pa in {int((~ok).sum())} of "
                     f"{len(seeds)} realizations: raise the largest pressure to bracket it")
         if ok.any():
             warnings.warn(warn[-1], UserWarning, stacklevel=2)
-    a = box / n
     df.attrs = {
-        "units": units,
-        "eta": eta,
-        "E_star": E_star,
-        "flow_stop_pressure": stop_mean,
-        "flow_stop_pressure_std": stop_std,
+        "units": units, "eta": eta, "E_star": E_star,
+        "flow_stop_pressure": float(np.exp(np.mean(np.log(sv[ok])))) if ok.any() else math.nan,
+        "flow_stop_pressure_std": float(np.std(sv[ok], ddof=1)) if ok.sum() > 1 else math.nan,
         "flow_stop_per_seed": {str(s): stops[int(s)][0] for s in seeds},
-        "per_seed": {str(s): {"area_fraction": results[(n, s)][:, 0].tolist(),
-                              "u_mean": results[(n, s)][:, 1].tolist(),
-                              "sigma_eff": (0.5 * (results[(n, s)][:, 2]
-                                                   + results[(n, s)][:, 3])).tolist()}
-                     for s in seeds},
+        "per_seed": {str(s): _per_seed(results[(n, s)]) for s in seeds},
         "flow_stop_log_bracket": max((stops[int(s)][1] for s in seeds if
                                       np.isfinite(stops[int(s)][1])), default=math.nan),
-        "provenance": {
-            "method": "ContactMechanics constrained conjugate gradients (Polonsky-Keer), "
-                      "periodic half-space; Reynolds finite volumes, harmonic face "
-                      "conductance, imposed mean gradient along x and y",
-            "n": n, "seeds": [int(s) for s in seeds], "box": box, "pixel": a,
-            "psd": _describe(psd), "psd_h_rms": float(psd.h_rms),
-            "h_rms_realized": h_real,
-            "pixels_per_wavelength": res_info["pixels_per_wavelength"],
-            "rolloff_modes": res_info["rolloff_modes"],
-            "grid_check_n": n // 2 if grid_check else None,
-            "stop_bisections": stop_bisections,
-            "cg_iterations": iters, "seconds": elapsed, "versions": _versions(),
-        },
+        "provenance": _provenance(psd, n, seeds, box, res_info, grid_check, stop_bisections,
+                                  run),
         "warnings": warn,
     }
     return df

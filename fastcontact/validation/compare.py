@@ -241,6 +241,37 @@ def _rel(th, ref):
     return np.where((ref == 0) & (th > 0), math.inf, r)
 
 
+#: units of the columns of :func:`compare_theories`
+_COMPARISON_UNITS = {"p0": "Pa", "u_ref": "m", "u_th": "m", "sigma_ref": "m^3/(Pa s)",
+                     "sigma_th": "m^3/(Pa s)", "area_ref": "1", "area_th": "1", "area_err": "1",
+                     "u_err": "1", "sigma_err": "1", "t_ratio": "1"}
+
+
+def _variant_columns(psd, E_star, eta, reference, p, a_th, theory, o, squeeze):
+    """One variant's columns of :func:`compare_theories` at the pressures ``p`` [Pa]: each
+    quantity's theory value (``a_th``: A/A0, the same for every variant), and where the
+    reference has it, the reference value and the relative error; ``t_ratio`` (T1)."""
+    from .. import contact
+
+    d = {"area_th": a_th}
+    if "area_fraction" in reference:
+        d["area_ref"] = reference["area_fraction"].to_numpy(float)
+        d["area_err"] = _rel(a_th, d["area_ref"])
+    u_th = contact.mean_separation(psd, p, E_star, gamma=o["gamma"])
+    d["u_th"] = u_th
+    if "u_mean" in reference:
+        d["u_ref"] = reference["u_mean"].to_numpy(float)
+        d["u_err"] = _rel(u_th, d["u_ref"])
+    s_th = theory_sigma(psd, p, E_star, eta, theory, **o)
+    d["sigma_th"] = s_th
+    if "sigma_eff" in reference:
+        d["sigma_ref"] = reference["sigma_eff"].to_numpy(float)
+        d["sigma_err"] = _rel(s_th, d["sigma_ref"])
+    if squeeze and {"u_mean", "sigma_eff"} <= set(reference.columns):
+        d["t_ratio"] = squeeze_time_ratio(psd, E_star, reference, theory, p, **o)
+    return d
+
+
 def compare_theories(psd, E_star, reference, *, variants=None, calibration=None, squeeze=True):
     """Every theory (with its options) beside a reference: relative errors per pressure.
 
@@ -293,23 +324,8 @@ def compare_theories(psd, E_star, reference, *, variants=None, calibration=None,
     stops = {}
     for label, theory, opts in variants:
         o = _options(theory, opts)
-        d = {"label": np.full(p.size, label), "theory": np.full(p.size, theory), "p0": p,
-             "area_th": a_th}
-        if "area_fraction" in reference:
-            d["area_ref"] = reference["area_fraction"].to_numpy(float)
-            d["area_err"] = _rel(a_th, d["area_ref"])
-        u_th = contact.mean_separation(psd, p, E_star, gamma=o["gamma"])
-        d["u_th"] = u_th
-        if "u_mean" in reference:
-            d["u_ref"] = reference["u_mean"].to_numpy(float)
-            d["u_err"] = _rel(u_th, d["u_ref"])
-        s_th = theory_sigma(psd, p, E_star, eta, theory, **o)
-        d["sigma_th"] = s_th
-        if "sigma_eff" in reference:
-            d["sigma_ref"] = reference["sigma_eff"].to_numpy(float)
-            d["sigma_err"] = _rel(s_th, d["sigma_ref"])
-        if squeeze and {"u_mean", "sigma_eff"} <= set(reference.columns):
-            d["t_ratio"] = squeeze_time_ratio(psd, E_star, reference, theory, p, **o)
+        d = {"label": np.full(p.size, label), "theory": np.full(p.size, theory), "p0": p}
+        d.update(_variant_columns(psd, E_star, eta, reference, p, a_th, theory, o, squeeze))
         rows.append(pd.DataFrame(d))
         st = theory_flow_stop(psd, E_star, theory, **o)
         stops[label] = {"theory": st, "reference": stop_ref,
@@ -318,7 +334,5 @@ def compare_theories(psd, E_star, reference, *, variants=None, calibration=None,
     out = pd.concat(rows, ignore_index=True)
     out.attrs = {"flow_stop": stops, "E_star": E_star, "eta": eta,
                  "reference_provenance": reference.attrs.get("provenance", {}),
-                 "units": {"p0": "Pa", "u_ref": "m", "u_th": "m", "sigma_ref": "m^3/(Pa s)",
-                           "sigma_th": "m^3/(Pa s)", "area_ref": "1", "area_th": "1",
-                           "area_err": "1", "u_err": "1", "sigma_err": "1", "t_ratio": "1"}}
+                 "units": dict(_COMPARISON_UNITS)}
     return out
