@@ -95,8 +95,9 @@ def test_parseval_of_the_realization():
 @pytest.mark.parametrize("n", [8, 16, 24, 64])
 def test_nested_uniform_sets_every_mode_nyquist_included(n):
     # independent reference, one mode at a time: mode (i, j) (signed, fftfreq order) takes its
-    # number from the smallest grid m of the chain n, n/2, ... (>= 8) whose signed range
-    # [-(m//2), (m-1)//2] holds both indices, generator default_rng([seed, m])
+    # number from the smallest grid m of the chain n, n/2, ... (>= 8) with
+    # max(|i|, |j|) <= (m-1)//2, else from the n grid (its Nyquist row and column), generator
+    # default_rng([seed, m])
     from fastcontact.validation.bem import _nested_uniform
     seed = 7
     chain = [n]
@@ -107,7 +108,7 @@ def test_nested_uniform_sets_every_mode_nyquist_included(n):
     ref = np.empty((n, n))
     for a, i in enumerate(signed):
         for b, j in enumerate(signed):
-            m = min(m for m in chain if -(m // 2) <= min(i, j) and max(i, j) <= (m - 1) // 2)
+            m = min([m for m in chain if max(abs(i), abs(j)) <= (m - 1) // 2] + [n])
             ref[a, b] = draws[m][i % m, j % m]
     got = _nested_uniform(n, seed)
     assert np.array_equal(got, ref)  # the Nyquist row/column (i = -n/2) included

@@ -92,26 +92,26 @@ def _check_pos(name, value, unit):
 
 def _nested_uniform(n, seed):
     """Uniform [0,1) numbers per lattice mode that do not depend on n for the modes n and 2n
-    share: the mode (i, j) (signed indices) takes its number from the smallest grid of the
-    chain n, n/2, n/4, … (down to an odd size or 8) that holds it, each grid with its own
-    generator ``default_rng([seed, size])``."""
+    share: the mode (i, j) (signed indices) takes its number from the smallest grid m of the
+    chain n, n/2, n/4, … (down to an odd size or 8) with max(|i|, |j|) <= (m-1)//2, each grid
+    with its own generator ``default_rng([seed, m])``; the modes no sub-grid holds (the
+    grid's own Nyquist row and column i = -n/2 or j = -n/2 among them) from the n grid.
+
+    A sub-grid's Nyquist mode (-m/2) is not shared: on the m grid it is its own conjugate
+    (phase 0), on the finer grids -m/2 and +m/2 are distinct modes."""
     sizes = [n]
     while sizes[-1] % 2 == 0 and sizes[-1] // 2 >= 8:
         sizes.append(sizes[-1] // 2)
     i = np.fft.fftfreq(n, 1.0 / n).astype(np.int64)
     I, J = np.meshgrid(i, i, indexing="ij")
-    out = np.full((n, n), np.nan)
+    reach = np.maximum(np.abs(I), np.abs(J))
+    out = np.empty((n, n))
     done = np.zeros((n, n), dtype=bool)
-    for m in reversed(sizes):  # smallest first
-        # the signed indices of an m×m grid run over [-(m//2), (m-1)//2] (fftfreq's order):
-        # [-m/2, m/2) for even m, Nyquist row and column included
-        lo, hi = -(m // 2), (m - 1) // 2
-        inside = ~done & (I >= lo) & (I <= hi) & (J >= lo) & (J <= hi)
+    for m in reversed(sizes):  # smallest first; the n grid takes every mode left
+        inside = ~done & ((reach <= (m - 1) // 2) | (m == n))
         r = np.random.default_rng([int(seed), int(m)]).random((m, m))
         out[inside] = r[I[inside] % m, J[inside] % m]
         done |= inside
-    if not done.all():  # pragma: no cover - the largest grid is the whole lattice
-        raise AssertionError("_nested_uniform left lattice modes unset")
     return out
 
 
