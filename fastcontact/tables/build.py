@@ -368,17 +368,15 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
         constants, ``fitted`` and the calibration's ``provenance`` are recorded in
         ``info["calibration"]`` (covered by the file's metadata_sha256).
     anisotropy : float
-        Peklenik/Tripp number γ_T = ξ_x/ξ_y >= 1 [-] of roughness stretched along x
-        (issue 14; docs/theory/extensions.md §3). 1 (default): isotropic tables, bit for bit
-        those built without the keyword. γ_T > 1 needs "emt" in ``theories``: the tables
-        then also hold σ̄_xx and σ̄_yy of the anisotropic Bruggeman medium
-        (:func:`fastcontact.flow.anisotropy.precompute_directional`, with this table's γ and
-        emt_threshold) on their nodes as the columns ``sigma_emt_x``, ``sigma_emt_y`` (and
-        their derivatives, φ_p, percolated); ``options`` records ``anisotropy`` and
-        ``anisotropy_form`` and ``info["directional"]`` the directional percolation
-        pressures and interpolation errors, all covered by the metadata digest. The plain
-        "emt" columns stay the isotropic medium of the angle-averaged C(q); read a direction
-        with ``Tables.conductivity(..., direction="x"|"y")`` or ``seal_leak(..., direction=)``.
+        Peklenik number γ_T = ξ_x/ξ_y >= 1 [-] of roughness stretched along x; 1 (default):
+        isotropic tables, bit for bit. γ_T > 1 (needs "emt") adds the columns ``<stem>_x``,
+        ``<stem>_y`` of :data:`~fastcontact.flow.anisotropy.DIRECTIONAL_STEMS` (σ̄_xx, σ̄_yy of
+        the anisotropic Bruggeman medium by
+        :func:`~fastcontact.flow.anisotropy.precompute_directional`, with this γ and
+        emt_threshold), recorded in ``options`` (``anisotropy``, ``anisotropy_form``) and
+        ``info["directional"]`` under the metadata digest; the plain "emt" columns stay
+        isotropic. Read a direction with ``Tables.conductivity(..., direction=)`` or
+        ``seal_leak(..., direction=)`` (docs/theory/extensions.md §3).
     anisotropy_form : {"self_consistent", "fixed"}
         Depolarization form of the anisotropic medium (used only when γ_T != 1).
 
@@ -394,6 +392,22 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
     """
     t_start = time.perf_counter()
     _check_psd(psd)
+    theories, options, cal_block = _options(theories, gamma, a_perc, alpha_cj, emt_tol,
+                                            emt_almqvist, emt_threshold, calibration)
+    aniso = _check_anisotropy(anisotropy, anisotropy_form, theories, options)
+    grid = _base_grid(psd, options["gamma"], grid, points_per_decade)
+    tol = _check_tolerance(tolerance)
+    lnp, cols, errs, stats = _refine(psd, grid, theories, _sigma_options(options), tol, refine)
+    data, perc_p, zg = _assemble(psd, lnp, cols, theories, options)
+    info = _info(psd, options["gamma"], perc_p, errs, tol, lnp.size, stats, t_start, cal_block)
+    tables = Tables(psd, theories, options, grid, zg, data, info)
+    return tables if aniso is None else _with_directional(tables, aniso, t_start)
+
+
+def _options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist, emt_threshold,
+             calibration):
+    """(theories, validated options, calibration block or None) of precompute's keywords;
+    a calibration sets the four :data:`CALIBRATED` constants first."""
     cal_block = None
     if calibration is not None:
         const, cal_block = _calibration_block(calibration, {
@@ -401,38 +415,49 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
         gamma, alpha_cj, a_perc, emt_threshold = (const[k] for k in CALIBRATED)
     theories, options = _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist,
                                         emt_threshold)
-    aniso = _check_anisotropy(anisotropy, anisotropy_form, theories, options)
-    gamma = options["gamma"]
-    if grid is None:
-        ppd = DEFAULT_POINTS_PER_DECADE if points_per_decade is None else points_per_decade
-        ppd = int(check_range("points_per_decade", ppd, 1, 1000, "[1/decade]"))
-        grid = default_grid(psd, gamma, ppd)
-    else:
-        grid = _check_grid(grid)
-    tol = _check_tolerance(tolerance)
-    sig_opts = dict(gamma=gamma, a_perc=options["a_perc"], alpha_cj=options["alpha_cj"],
-                    tol=options["emt_tol"], almqvist=options["emt_almqvist"],
-                    emt_threshold=options.get("emt_threshold", 0.5))
-    lnp, cols, errs, stats = _refine(psd, grid, theories, sig_opts, tol, refine)
-    data, perc_p, zg = _assemble(psd, lnp, cols, theories, options)
+    return theories, options, cal_block
+
+
+def _base_grid(psd, gamma, grid, points_per_decade):
+    """The base p̄ :class:`Grid`: the user's ``grid`` checked, else :func:`default_grid`."""
+    if grid is not None:
+        return _check_grid(grid)
+    ppd = DEFAULT_POINTS_PER_DECADE if points_per_decade is None else points_per_decade
+    ppd = int(check_range("points_per_decade", ppd, 1, 1000, "[1/decade]"))
+    return default_grid(psd, gamma, ppd)
+
+
+def _sigma_options(options):
+    """The keywords of :func:`~fastcontact.flow.conductivity.sigma_bar` from the options."""
+    return dict(gamma=options["gamma"], a_perc=options["a_perc"], alpha_cj=options["alpha_cj"],
+                tol=options["emt_tol"], almqvist=options["emt_almqvist"],
+                emt_threshold=options.get("emt_threshold", 0.5))
+
+
+def _info(psd, gamma, perc_p, errs, tol, nodes, stats, t_start, cal_block):
+    """The tables' ``info``: asymptote (eq. 3), percolation pressures, midpoint errors,
+    refinement statistics, build time [s] and the calibration block (if any)."""
     u0, beta = asymptote(psd, gamma)
     info = {"asymptote_u0_over_h": u0 / psd.h_rms, "asymptote_beta": beta,
             "percolation_p_over_E": perc_p,
             "interpolation_error": {c: float(e.max()) for c, e in errs.items()},
-            "tolerance": tol, "sigma_floor": SIGMA_FLOOR, "nodes": int(lnp.size), **stats,
+            "tolerance": tol, "sigma_floor": SIGMA_FLOOR, "nodes": int(nodes), **stats,
             "build_seconds": time.perf_counter() - t_start}
     if cal_block is not None:
         info["calibration"] = cal_block
-    tables = Tables(psd, theories, options, grid, zg, data, info)
-    if aniso is None:
-        return tables
+    return info
+
+
+def _with_directional(tables, aniso, t_start):
+    """``tables`` with the σ̄_xx, σ̄_yy columns of γ_T, form = ``aniso`` on their nodes."""
     from ..flow.anisotropy import directional_columns, precompute_directional
     d = precompute_directional(tables, aniso[0], form=aniso[1])
-    data = dict(data, **directional_columns(tables, d))
-    options = dict(options, anisotropy=aniso[0], anisotropy_form=aniso[1])
-    info["directional"] = dict(d.info)
+    data = dict(tables.data, **directional_columns(tables, d))
+    options = dict(tables.options, anisotropy=aniso[0], anisotropy_form=aniso[1])
+    info = dict(tables.info, directional=dict(d.info))
     info["build_seconds"] = time.perf_counter() - t_start
-    return Tables(psd, theories, options, grid, zg, data, info)
+    return Tables(tables.surface, tables.theories, options, tables.grid, tables.zeta_grid, data,
+                  info)
 
 
 def _check_anisotropy(anisotropy, form, theories, options):
