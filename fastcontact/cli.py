@@ -15,6 +15,9 @@ Commands
 
 Bad input (invalid scene, missing file, wrong option) exits with code 2 and a one-line
 message on stderr, no traceback.
+
+This module holds the entry point :func:`main` and the command runners; the argument parser
+(:func:`build_parser`, re-exported here) is built in :mod:`fastcontact.cli_parser`.
 """
 from __future__ import annotations
 

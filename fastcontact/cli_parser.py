@@ -36,6 +36,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _quantity(dim):
+    """Option type: a quantity of dimension ``dim`` in SI units (a number, or e.g. '0.72 mm')."""
     def conv(text):
         from ._core.units import parse_quantity
         try:
@@ -95,6 +96,7 @@ def _add_tables_parser(sub):
 
 
 def build_parser():
+    """The ``fastcontact`` argument parser: every command, subcommand and option."""
     p = _Parser(prog="fastcontact", description="Persson contact mechanics, fluid squeeze-out "
                 "and seal leakage between rough surfaces (Lorenz & Persson 2010).")
     from . import __version__

@@ -9,7 +9,8 @@ command resumes exactly (partitions of this ``sweep_key`` with one row per case 
 row is lost or duplicated, even after SIGKILL). SIGINT / SIGTERM stop the cluster, mark the
 manifest "interrupted" and raise :class:`SweepInterrupted` (CLI: one line, exit 130 / 143).
 ``OUT/.sweep.lock`` keeps a second sweep out of a folder in use; the lock of a dead run (same
-host: pid gone; other host: no heartbeat for :data:`LOCK_STALE_SECONDS`) is taken over.
+host: pid gone; other host: no heartbeat for :data:`LOCK_STALE_SECONDS`) is taken over (the
+lock, the signal handling and the errors live in :mod:`.sweep_control`).
 Workers: :func:`local_cluster` (spawned processes, numba's fork-safe threading set-up).
 """
 from __future__ import annotations
