@@ -226,15 +226,12 @@ def separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, out):
     """
     qb, c, e, cum3, kinks = sk
     kt0, kdt, kval, kder, rdt, rval, rder = ktab
-    out[0] = 0.0
-    out[1] = 0.0
-    out[2] = 0.0
-    out[3] = 0.0
+    for i in range(4):
+        out[i] = 0.0
     q1 = qb[-1]
     if a >= q1 or P <= 0.0:
         return
-    r = q1 / a - 1.0
-    tau_hi = math.log(r)
+    tau_hi = math.log(q1 / a - 1.0)
     ia = seg_index(qb, a)
     # the first (partial) segment's closed-form moment: pref * expm1(k ln(q/a)) / k
     k3 = 4.0 + e[ia]

@@ -84,14 +84,12 @@ def k_lnu_of_lnp(tab, lnp_q):
 @njit(cache=True)
 def k_lnp_of_lnu(tab, lnu_q):
     """ln p̄ at ln(ū/h_rms) (inverse; quintic Hermite in ln ū); NaN outside the table."""
-    lnp, lnu, dlnu, d2 = tab.lnp, tab.lnu, tab.dlnu, tab.d2lnu
-    i = locate_desc(lnu_q, lnu, tab.bu_lo, tab.bu_dz, tab.bu_idx)
+    i = locate_desc(lnu_q, tab.lnu, tab.bu_lo, tab.bu_dz, tab.bu_idx)
     if i < 0:
         return math.nan
-    a0 = dlnu[i]
-    a1 = dlnu[i + 1]
-    return quintic_interval(lnu_q, lnu[i], lnu[i + 1], lnp[i], lnp[i + 1], 1.0 / a0, 1.0 / a1,
-                            -d2[i] / a0 ** 3, -d2[i + 1] / a1 ** 3)
+    lnp, lnu, a, d2 = tab.lnp, tab.lnu, tab.dlnu, tab.d2lnu  # a = d ln ū/d ln p̄ at the nodes
+    return quintic_interval(lnu_q, lnu[i], lnu[i + 1], lnp[i], lnp[i + 1], 1.0 / a[i],
+                            1.0 / a[i + 1], -d2[i] / a[i] ** 3, -d2[i + 1] / a[i + 1] ** 3)
 
 
 @njit(cache=True)

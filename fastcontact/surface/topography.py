@@ -367,8 +367,7 @@ def _check_parseval(psd, h2):
 
 # ============================================================================ public API
 def _scans_psd(h, spacing, n_bins, window, detrend):
-    """(TabulatedPSD, mean square height [m²]) of line scans: the rows of ``h`` (or ``h`` itself
-    if 1-D), their averaged 1-D spectrum converted by :func:`~fastcontact.surface.abel.abel_fit`."""
+    """(TabulatedPSD, mean square height [m²]) of the line scans ``h`` (rows, or one 1-D scan)."""
     rows = h[None, :] if h.ndim == 1 else h
     a = spacing if np.ndim(spacing) == 0 else spacing[1]
     q, d, w, h2 = _spectrum_1d(rows, a, n_bins, window, detrend)
