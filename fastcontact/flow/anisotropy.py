@@ -40,10 +40,11 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from .._core.cache import PerObjectCache
+from .._core.docs import fill_params
 from .._core.validate import check_positive
-from ..contact import percolation_pressure
-from .directional import (FORMS, N_PANELS, _check, check_anisotropy, directional_sigma_bar,
-                          directional_threshold, sigma_directional)
+from ..contact import area_fraction, percolation_pressure
+from .conductivity import check_emt_threshold, conductivity
+from .directional import FORMS, N_PANELS, _check, directional_sigma_bar, directional_threshold
 
 __all__ = [
     "FORMS",
@@ -51,7 +52,6 @@ __all__ = [
     "DirectionalTable",
     "directional_sigma_bar",
     "directional_threshold",
-    "check_anisotropy",
     "precompute_directional",
     "directional_tables",
     "directional_columns",
@@ -60,6 +60,56 @@ __all__ = [
     "sigma_directional",
     "DIRECTIONAL_STEMS",
 ]
+
+
+@fill_params
+def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, direction="x", *,
+                      form="self_consistent", gamma=1.0, a_perc=0.5, alpha_cj=1.0,
+                      n_panels=N_PANELS, emt_threshold=0.5):
+    """Directional interfacial conductivity σ_xx or σ_yy [m³/(Pa·s)] by direct quadrature.
+
+    Parameters
+    ----------
+    psd : PSD
+        Angle-averaged roughness spectrum (Persson convention).
+    {{p_contact E_star_scalar eta}}
+    theory : {"emt", "critical_junction", "average"}
+        Flow theory (module docstring).
+    anisotropy : float
+        Peklenik/Tripp number γ_T = ξ_x/ξ_y >= 1 [-]; 1 = isotropic (exactly the
+        isotropic :func:`~fastcontact.flow.conductivity.conductivity`).
+    direction : {"x", "y"}
+        Flow along the long correlation length ("x", the grooves) or across it ("y").
+    form : {"self_consistent", "fixed"}
+        Depolarization factors in the anisotropic effective medium or in an isotropic host.
+    gamma, a_perc, alpha_cj, emt_threshold :
+        As in :func:`~fastcontact.flow.conductivity.conductivity` (``a_perc``: the critical
+        junction's isotropic threshold; ``emt_threshold``: the effective medium's).
+    n_panels : int
+        Gauss–Legendre panels (order 10) of the P(u) quadrature in A (EMT).
+
+    Returns
+    -------
+    (sigma [m³/(Pa·s)], percolated [bool]) arrays of p's shape.
+    """
+    g = _check(theory, anisotropy, direction, form)
+    p = check_positive("p", p, "[Pa]")
+    E_star = float(check_positive("E_star", E_star, "[Pa]"))
+    eta = float(check_positive("eta", eta, "[Pa·s]"))
+    a_c = float(check_emt_threshold(emt_threshold))
+    if g == 1.0 or theory == "average":
+        return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_perc,
+                            alpha_cj=alpha_cj, emt_threshold=a_c)
+    if theory == "critical_junction":
+        a_dir = directional_threshold(float(a_perc), g, direction)
+        return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_dir,
+                            alpha_cj=alpha_cj)
+    sx, sy = directional_sigma_bar(psd, np.ravel(p) / E_star, g, form=form, gamma=gamma,
+                                   n_panels=n_panels, emt_threshold=a_c)
+    sb = (sx if direction == "x" else sy).reshape(np.shape(p))
+    a_thr = a_c if form == "self_consistent" else directional_threshold(a_c, g, direction)
+    perc = np.asarray(area_fraction(psd, p, E_star)) >= a_thr
+    return sb * psd.h_rms ** 3 / (12.0 * eta), perc
 
 
 # =========================================================================== table path

@@ -1,11 +1,11 @@
 """Directional conductivities σ_xx, σ_yy of anisotropic roughness by direct quadrature.
 
 The anisotropic 2-D Bruggeman medium on the u1-based P(u) of the angle-averaged spectrum
-(:func:`directional_sigma_bar`), its validating wrapper in SI units
-(:func:`sigma_directional`) and the directional percolation thresholds of the "fixed" form
-(:func:`directional_threshold`). The model (forms, thresholds, the critical junction per
-direction) is described in :mod:`fastcontact.flow.anisotropy`, which re-exports every name
-here; the table path (σ̄_xx, σ̄_yy splines and table views) lives there.
+(:func:`directional_sigma_bar`), the checks of its options and the directional percolation
+thresholds of the "fixed" form (:func:`directional_threshold`). The model (forms,
+thresholds, the critical junction per direction) is described in
+:mod:`fastcontact.flow.anisotropy`, which re-exports every name here and holds the SI
+wrapper :func:`~fastcontact.flow.anisotropy.sigma_directional` and the table path.
 
 References: B.N.J. Persson, J. Phys.: Condens. Matter 22, 265004 (2010),
 doi:10.1088/0953-8984/22/26/265004; D. Stroud, Phys. Rev. B 12, 3368 (1975),
@@ -18,22 +18,17 @@ import math
 import numpy as np
 from scipy.special import erf
 
-from .._core.docs import fill_params
-from .._core.validate import check_positive
-from ..contact import area_fraction
 from ..contact._kernels import PANEL, psd_kernel
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.special import k_table
 from ._anisotropic_kernels import solve_dir, solve_self_consistent, u1_nodes
-from .conductivity import check_anisotropy, check_emt_threshold, check_theory, conductivity
+from .conductivity import check_anisotropy, check_emt_threshold, check_theory
 
 __all__ = [
     "FORMS",
     "N_PANELS",
-    "check_anisotropy",
     "directional_sigma_bar",
     "directional_threshold",
-    "sigma_directional",
 ]
 
 FORMS = ("self_consistent", "fixed")
@@ -125,53 +120,3 @@ def directional_threshold(a_perc, anisotropy, direction):
     """Directional percolation area fraction of the 'fixed' form: odds scaled by γ_T^{±1}."""
     g = anisotropy if direction == "x" else 1.0 / anisotropy
     return g * a_perc / (1.0 - a_perc + g * a_perc)
-
-
-@fill_params
-def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, direction="x", *,
-                      form="self_consistent", gamma=1.0, a_perc=0.5, alpha_cj=1.0,
-                      n_panels=N_PANELS, emt_threshold=0.5):
-    """Directional interfacial conductivity σ_xx or σ_yy [m³/(Pa·s)] by direct quadrature.
-
-    Parameters
-    ----------
-    psd : PSD
-        Angle-averaged roughness spectrum (Persson convention).
-    {{p_contact E_star_scalar eta}}
-    theory : {"emt", "critical_junction", "average"}
-        Flow theory (module docstring).
-    anisotropy : float
-        Peklenik/Tripp number γ_T = ξ_x/ξ_y >= 1 [-]; 1 = isotropic (exactly the
-        isotropic :func:`~fastcontact.flow.conductivity.conductivity`).
-    direction : {"x", "y"}
-        Flow along the long correlation length ("x", the grooves) or across it ("y").
-    form : {"self_consistent", "fixed"}
-        Depolarization factors in the anisotropic effective medium or in an isotropic host.
-    gamma, a_perc, alpha_cj, emt_threshold :
-        As in :func:`~fastcontact.flow.conductivity.conductivity` (``a_perc``: the critical
-        junction's isotropic threshold; ``emt_threshold``: the effective medium's).
-    n_panels : int
-        Gauss–Legendre panels (order 10) of the P(u) quadrature in A (EMT).
-
-    Returns
-    -------
-    (sigma [m³/(Pa·s)], percolated [bool]) arrays of p's shape.
-    """
-    g = _check(theory, anisotropy, direction, form)
-    p = check_positive("p", p, "[Pa]")
-    E_star = float(check_positive("E_star", E_star, "[Pa]"))
-    eta = float(check_positive("eta", eta, "[Pa·s]"))
-    a_c = float(check_emt_threshold(emt_threshold))
-    if g == 1.0 or theory == "average":
-        return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_perc,
-                            alpha_cj=alpha_cj, emt_threshold=a_c)
-    if theory == "critical_junction":
-        a_dir = directional_threshold(float(a_perc), g, direction)
-        return conductivity(psd, p, E_star, eta, theory, gamma=gamma, a_perc=a_dir,
-                            alpha_cj=alpha_cj)
-    sx, sy = directional_sigma_bar(psd, np.ravel(p) / E_star, g, form=form, gamma=gamma,
-                                   n_panels=n_panels, emt_threshold=a_c)
-    sb = (sx if direction == "x" else sy).reshape(np.shape(p))
-    a_thr = a_c if form == "self_consistent" else directional_threshold(a_c, g, direction)
-    perc = np.asarray(area_fraction(psd, p, E_star)) >= a_thr
-    return sb * psd.h_rms ** 3 / (12.0 * eta), perc
