@@ -1,0 +1,332 @@
+"""Building the time primitive of one (tables, theory) in one parallel pass.
+
+Part of :mod:`fastcontact.squeeze.primitive`. The x0-independent state (ln π_c, ln σ̄ and
+their ln v-derivatives) is tabulated once on a fine grid in ln v (:func:`profile`); each x0
+row then integrates T(x0, v) = ∫_v^∞ dv'/(σ̄ (1 - π_c/π0)) (Lorenz & Persson 2010, eqs. (18),
+(19), (23); arXiv:1004.1037) with composite Gauss–Legendre panels in z = ln(v/v∞ - 1), and
+:func:`measure_error` checks the interpolant against direct quadrature at cell centres.
+"""
+from __future__ import annotations
+
+import math
+import time as _clock
+from collections import namedtuple
+
+import numpy as np
+from numba import njit, prange
+
+from . import _kernels as qk
+from ._primitive_eval import Primitive, _index_map, row_value, stencil, t_of_z
+
+__all__ = ["build", "measure_error", "profile", "fast_limit", "Profile", "DXI", "Z_LO", "DZ",
+           "NODE_ORDER", "X_END", "X_FALLBACK"]
+
+#: grid spacing in ξ = x0 - ln σ̄(x0) of the x0 rows
+DXI = 0.1
+#: z = ln(v/v∞ - 1) grid: lower end and spacing (below: analytic log singularity)
+Z_LO = -10.0
+DZ = 0.25
+#: Gauss–Legendre order per z panel of the node quadrature
+NODE_ORDER = 6
+#: relative step of the central difference for dh/dz at the nodes
+HZ = 1e-4
+
+
+#: x0-independent state along s = ln v (cubic Hermite on a fine uniform grid, below the table
+#: top): ell = ln π_c, lam = ln σ̄ and their s-derivatives; above v_top the analytic tail
+Profile = namedtuple("Profile", "s0 ds A")  # A[i] = (ell, dell, lam, dlam) at s0 + i ds
+#: spacing of the profile grid in ln v and the central-difference step of its derivatives
+PROFILE_DS = 0.004
+PROFILE_FD = 1e-5
+
+
+@njit(cache=True)
+def _state_fd(tab, s):
+    """(ln π_c, ln σ̄) of the tables at ln v = s."""
+    lp = qk.k_lnp_of_lnu(tab, s)
+    return lp, math.log(qk.k_sigma_of_lnp(tab, lp))
+
+
+@njit(parallel=True, cache=True)
+def _profile_kernel(tab, s0, ds, A):
+    n = A.shape[0]
+    hh = PROFILE_FD
+    for i in prange(n):
+        s = s0 + i * ds
+        lp, ls = _state_fd(tab, s)
+        A[i, 0] = lp
+        A[i, 2] = ls
+        if 0 < i < n - 1:
+            la, lsa = _state_fd(tab, s - hh)
+            lb, lsb = _state_fd(tab, s + hh)
+            A[i, 1] = (lb - la) / (2.0 * hh)
+            A[i, 3] = (lsb - lsa) / (2.0 * hh)
+        else:  # one-sided, second order, inside the table
+            sg = 1.0 if i == 0 else -1.0
+            la, lsa = _state_fd(tab, s + sg * hh)
+            lb, lsb = _state_fd(tab, s + 2.0 * sg * hh)
+            A[i, 1] = sg * (-3.0 * lp + 4.0 * la - lb) / (2.0 * hh)
+            A[i, 3] = sg * (-3.0 * ls + 4.0 * lsa - lsb) / (2.0 * hh)
+
+
+@njit(cache=True)
+def _pstate(pf, mp, v):
+    """(ln π_c, ln σ̄, d ln π_c/d ln v, d ln σ̄/d ln v) at v: the profile below the table
+    top, the analytic tail above."""
+    if v > mp.v_top:
+        y = v + mp.d
+        y2c = y * y - mp.c
+        return (mp.x_min - (v - mp.v_top) / mp.u0, math.log(y * y2c), -v / mp.u0,
+                v * (3.0 * y * y - mp.c) / (y * y2c))
+    u = (math.log(v) - pf.s0) / pf.ds
+    i = int(u)
+    A = pf.A
+    n = A.shape[0]
+    if i < 0:
+        i = 0
+    if i > n - 2:
+        i = n - 2
+    t = u - i
+    h = pf.ds
+    t2 = t * t
+    t3 = t2 * t
+    h00 = 2.0 * t3 - 3.0 * t2 + 1.0
+    h10 = (t3 - 2.0 * t2 + t) * h
+    h01 = -2.0 * t3 + 3.0 * t2
+    h11 = (t3 - t2) * h
+    g00 = (6.0 * t2 - 6.0 * t) / h
+    g10 = 3.0 * t2 - 4.0 * t + 1.0
+    g11 = 3.0 * t2 - 2.0 * t
+    e0, de0, l0, dl0 = A[i, 0], A[i, 1], A[i, 2], A[i, 3]
+    e1, de1, l1, dl1 = A[i + 1, 0], A[i + 1, 1], A[i + 1, 2], A[i + 1, 3]
+    return (h00 * e0 + h10 * de0 + h01 * e1 + h11 * de1,
+            h00 * l0 + h10 * dl0 + h01 * l1 + h11 * dl1,
+            g00 * (e0 - e1) + g10 * de0 + g11 * de1,
+            g00 * (l0 - l1) + g10 * dl0 + g11 * dl1)
+
+
+@njit(cache=True)
+def _plnv(pf, mp, x):
+    """ln v with ln π_c(v) = x on the profile (Newton; the tail above the table top)."""
+    if x <= mp.x_min:
+        return math.log(mp.v_top + mp.u0 * (mp.x_min - x))
+    # start: bisection bracket over the grid (ell decreases with s)
+    lo = 0
+    hi = pf.A.shape[0] - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if pf.A[mid, 0] > x:
+            lo = mid
+        else:
+            hi = mid
+    s = pf.s0 + (lo + 0.5) * pf.ds
+    for _ in range(50):
+        e, lm, de, dl = _pstate(pf, mp, math.exp(s))
+        step = (e - x) / de
+        s -= step
+        if abs(step) < 1e-15:
+            break
+    return s
+
+
+@njit(cache=True)
+def _h(pf, mp, x0, vinf, z):
+    """dT/d(-z) at z: the integrand (v - v∞)/(σ̄ (1 - π_c/π0)) in z."""
+    e = vinf * math.exp(z)
+    lp, lm, de, dl = _pstate(pf, mp, vinf + e)
+    return e / (math.exp(lm) * -math.expm1(lp - x0))
+
+
+@njit(cache=True)
+def _h_dlnh(pf, mp, x0, vinf, z):
+    """(h, d ln h/dz) at z (exact derivative of the profile's h)."""
+    e = vinf * math.exp(z)
+    v = vinf + e
+    lp, lm, de, dl = _pstate(pf, mp, v)
+    dd = -math.expm1(lp - x0)
+    q = math.exp(lp - x0)
+    r = e / v
+    return e / (math.exp(lm) * dd), 1.0 - r * dl + r * q * de / dd
+
+
+@njit(cache=True)
+def _panel(pf, mp, x0, vinf, za, zb, glx, glw):
+    """∫_{za}^{zb} h dz, one Gauss–Legendre panel."""
+    if not (zb > za):
+        return 0.0
+    hw = 0.5 * (zb - za)
+    mid = 0.5 * (za + zb)
+    acc = 0.0
+    for j in range(glx.size):
+        acc += glw[j] * _h(pf, mp, x0, vinf, mid + hw * glx[j])
+    return acc * hw
+
+
+@njit(cache=True)
+def _build_row(pf, mp, x0, vinf, lk, z0, dz, glx, glw, C, j):
+    """ln T and its z-derivatives at the ζ nodes (z = ζ - lk) of row j; returns the slope
+    S below the grid."""
+    nz = C.shape[1]
+    z_ext = math.log(mp.v_ext / vinf - 1.0) if mp.v_ext > vinf else -math.inf
+    z_prev = z_ext
+    T_prev = qk._tail_int(mp.c, mp.v_ext + mp.d, math.inf)
+    for k in range(nz - 1, -1, -1):
+        z = z0 + k * dz - lk
+        if z >= z_ext:
+            T = qk._tail_int(mp.c, vinf * (1.0 + math.exp(z)) + mp.d, math.inf)
+        else:
+            T = T_prev + _panel(pf, mp, x0, vinf, z, z_prev, glx, glw)
+            z_prev = z
+            T_prev = T
+        h, dlnh = _h_dlnh(pf, mp, x0, vinf, z)
+        C[j, k, 0] = math.log(T)
+        C[j, k, 1] = -h / T
+        C[j, k, 2] = -h * dlnh / T - (h / T) ** 2
+    # slope below the grid: h(z) = S + a e^z fitted to the two lowest nodes
+    h0 = -C[j, 0, 1] * math.exp(C[j, 0, 0])
+    h1 = -C[j, 1, 1] * math.exp(C[j, 1, 0])
+    a = (h1 - h0) / (math.exp(z0 + dz) - math.exp(z0))
+    return h0 - a * math.exp(z0)
+
+
+@njit(cache=True)
+def _lnkappa(pf, mp, vinf):
+    """ln κ of the row with equilibrium vinf (see :data:`Primitive`)."""
+    e, lm, de, dl = _pstate(pf, mp, vinf)
+    return 0.5 * math.log(1.0 + de * de + dl * dl)
+
+
+@njit(parallel=True, cache=True)
+def _build_kernel(pf, mp, xn, z0, dz, glx, glw, C, lnv, lnS, zs, sx, lk):
+    for j in prange(xn.size):
+        x0 = xn[j]
+        lv = _plnv(pf, mp, x0)
+        vinf = math.exp(lv)
+        lnv[j] = lv
+        lk[j] = _lnkappa(pf, mp, vinf)
+        sx[j] = _build_row(pf, mp, x0, vinf, lk[j], z0, dz, glx, glw, C, j)
+        e, lm, de, dl = _pstate(pf, mp, vinf)
+        lnS[j] = lv - math.log(-de) - lm  # S = v∞ |d ln v/d ln π| / σ̄(π0)
+        vs = math.exp(_plnv(pf, mp, x0 + mp.lnp_start))
+        zs[j] = math.log(vs / vinf - 1.0)
+
+
+@njit(parallel=True, cache=True)
+def _check_kernel(pf, mp, pr, xm, zm, glx, glw, err):
+    """Relative error of the interpolated T at (xm[i], zm[i]) against direct quadrature."""
+    for i in prange(xm.size):
+        x0 = xm[i]
+        vinf = math.exp(_plnv(pf, mp, x0))
+        st = stencil(pr, x0)
+        z = zm[i] - row_value(pr.lk, st)
+        v = vinf * (1.0 + math.exp(z))
+        z_ext = math.log(mp.v_ext / vinf - 1.0)
+        if z >= z_ext:
+            T = qk._tail_int(mp.c, v + mp.d, math.inf)
+        else:
+            T = qk._tail_int(mp.c, mp.v_ext + mp.d, math.inf)
+            m = int(math.ceil((z_ext - z) / (0.25 * pr.dz)))
+            hw = (z_ext - z) / m
+            for q in range(m):
+                T += _panel(pf, mp, x0, vinf, z + q * hw, z + (q + 1) * hw, glx, glw)
+        err[i] = abs(t_of_z(pr, st, vinf, z) / T - 1.0)
+
+
+@njit(cache=True)
+def _lnkappa_rows_k(pf, mp, xn, out):
+    for j in range(xn.size):
+        out[j] = _lnkappa(pf, mp, math.exp(_plnv(pf, mp, xn[j])))
+
+
+def _lnkappa_rows(pf, mp, xn):
+    out = np.empty(xn.size)
+    _lnkappa_rows_k(pf, mp, xn, out)
+    return out
+
+
+def profile(model, v_lo):
+    """The x0-independent state on s = ln v ∈ [ln v_lo, ln v_top] (see :data:`Profile`)."""
+    lnu = model.tables.u_range
+    s0 = max(math.log(v_lo) - 4 * PROFILE_DS, math.log(lnu[0]) + 1e-13)
+    s1 = math.log(lnu[1]) - 1e-13
+    n = int(math.ceil((s1 - s0) / PROFILE_DS)) + 1
+    ds = (s1 - s0) / (n - 1)
+    A = np.empty((n, 4))
+    _profile_kernel(model.tab, s0, ds, A)
+    return Profile(s0, ds, A)
+
+
+#: rows end X_END below the trap; cases within X_FALLBACK of it use the per-case quadrature
+#: (σ̄ collapses there faster than any fixed grid resolves; < 1 % of the pressure range)
+X_END = 0.005
+X_FALLBACK = 0.01
+
+
+def _kink(model):
+    """ln p̄ of the tables' last node with σ̄ > 0: beyond it σ̄^(1/3) is linear to the exact
+    percolation pressure, so ln σ̄ has a kink there that no smooth grid may straddle."""
+    lnp, n_open = model.tab[0], int(model.tab[6])
+    return float(lnp[n_open - 1]) if n_open < lnp.size else math.inf
+
+
+def fast_limit(model):
+    """Largest ln(p0/E*) the primitive serves (above: per-case quadrature)."""
+    lim = min(model.x_trap - X_FALLBACK, _kink(model) - 2 * X_FALLBACK)
+    return min(lim, model.x_max)
+
+
+def _x_nodes(model, dxi):
+    """x0 nodes uniform in ξ = x0 - ln σ̄(x0) on [x_min, x_hi]."""
+    x_hi = min(model.x_trap - X_END, _kink(model) - X_END, model.x_max)
+    xs = np.linspace(model.x_min, x_hi, 20001)
+    sig = np.empty(xs.size)
+    qk.sigma_kernel(model.tab, xs, sig)
+    xi = np.maximum.accumulate(xs - np.log(sig))
+    n = max(int(math.ceil((xi[-1] - xi[0]) / dxi)) + 1, 8)
+    xn = np.interp(np.linspace(xi[0], xi[-1], n), xi, xs)
+    xn[0], xn[-1] = model.x_min, x_hi
+    return np.ascontiguousarray(np.unique(xn))
+
+
+def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, order=NODE_ORDER, check=True):
+    """Build the primitive of ``model`` (a :class:`~fastcontact.squeeze.model.SqueezeModel`).
+
+    Returns ``(Primitive, info)``; ``info`` holds the grid sizes, build time and the measured
+    maximum relative interpolation error of T at cell centres (``max_rel_err_T``).
+    """
+    t0 = _clock.perf_counter()
+    mp, tab = model.mp, model.tab
+    xn = _x_nodes(model, dxi)
+    lnv_lo = np.empty(1)
+    qk.lnv_of_lnp_kernel(tab, mp, np.array([xn[-1]]), lnv_lo)
+    pf = profile(model, math.exp(lnv_lo[0]))
+    lk_max = float(np.max(_lnkappa_rows(pf, mp, xn)))
+    z_hi = math.log(mp.v_ext / math.exp(lnv_lo[0]) - 1.0) + lk_max
+    nz = int(math.ceil((z_hi - z_lo) / dz)) + 2
+    nx = xn.size
+    C = np.empty((nx, nz, 3))
+    lnv, lnS, zs, sx, lk = (np.empty(nx) for _ in range(5))
+    glx, glw = np.polynomial.legendre.leggauss(order)
+    _build_kernel(pf, mp, xn, float(z_lo), float(dz), glx, glw, C, lnv, lnS, zs, sx, lk)
+    pr = Primitive(xn, *_index_map(xn), float(z_lo), float(dz), nz, C, lnv, lnS, zs, sx, lk, float(mp.v_ext), float(mp.c), float(mp.d))
+    info = {"nx": int(nx), "nz": int(nz), "dxi": float(dxi), "build_seconds":
+            _clock.perf_counter() - t0}
+    if check:
+        info.update(measure_error(model, pr, pf))
+    return pr, info
+
+
+def measure_error(model, pr, pf, n_x=64, order=NODE_ORDER):
+    """Max relative error of the interpolated T at cell centres (n_x x0 cells × all z cells)."""
+    rng = np.random.default_rng(0)
+    served = int(np.searchsorted(pr.xn, fast_limit(model), side="right")) - 1
+    cells = np.unique(rng.integers(0, max(served, 1), n_x))  # cells the fast path serves
+    xm = 0.5 * (pr.xn[cells] + pr.xn[cells + 1])
+    zc = pr.z0 + (np.arange(pr.nz - 1) + 0.5) * pr.dz
+    X, Z = np.meshgrid(xm, zc, indexing="ij")
+    err = np.empty(X.size)
+    glx, glw = np.polynomial.legendre.leggauss(order)
+    _check_kernel(pf, model.mp, pr, np.ascontiguousarray(X.ravel()),
+                  np.ascontiguousarray(Z.ravel()), glx, glw, err)
+    return {"max_rel_err_T": float(np.max(err)), "checked_points": int(err.size)}
+

@@ -1,0 +1,235 @@
+"""The time primitive's record and its evaluation: ln T at (x0, z), its inverse z(T).
+
+Part of :mod:`fastcontact.squeeze.primitive` (the module docstring there states the
+mathematics). x0 rows combine with 4-point Lagrange weights (:func:`stencil`), z cells with
+the quintic Hermite of :func:`fastcontact.kernels.hermite.quintic_unit`; below the grid the
+analytic logarithmic part, above v_ext the closed-form flat-film tail (Lorenz & Persson 2010,
+eqs. (18), (19), (23); arXiv:1004.1037).
+"""
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from ..kernels.hermite import quintic_unit
+from . import _kernels as qk
+
+__all__ = ["Primitive", "first_row", "stencil", "row_value", "row_value_2", "t_of_z", "z_of_t"]
+
+#: the tabulated primitive (reduced units). xn (nx) x0 nodes and their locator (blo, bdz,
+#: bidx: fractional row index at uniform x0 samples from blo, step bdz); z0, dz, nz: the z grid; C (nx, nz, 3): ln T, d ln T/dz,
+#: d² ln T/dz²; lnv (nx): ln v∞; lnS (nx): ln of the relaxation time in τ0; zs (nx): z of the
+#: default start; sx (nx): slope dT/d(-z) below the grid; lk (nx): ln κ, the shift of the grid
+#: variable ζ = z + ln κ (κ = (1 + (d ln σ̄/d ln v)² + (d ln π_c/d ln v)²)^½ at v∞, so that
+#: the grid resolves rows where σ̄ collapses); v_ext, c, d: closed-form tail
+Primitive = namedtuple("Primitive", "xn blo bdz bidx z0 dz nz C lnv lnS zs sx lk v_ext c d")
+
+
+def _index_map(xn, per_node=8):
+    """(lo, dx, fidx): the fractional row index at uniform x0 samples (O(1) row location)."""
+    k = per_node * xn.size
+    xs = np.linspace(xn[0], xn[-1], k + 1)
+    return float(xn[0]), float((xn[-1] - xn[0]) / k), np.ascontiguousarray(
+        np.interp(xs, xn, np.arange(xn.size, dtype=np.float64)))
+
+
+@njit(cache=True, inline="always")
+def _locate(pr, x):
+    """Interval j with xn[j] <= x <= xn[j+1] (-1 outside): linear estimate of the index from
+    the uniform-x map, then a short walk."""
+    xn = pr.xn
+    n = xn.size
+    if not (xn[0] <= x <= xn[n - 1]):
+        return -1
+    u = (x - pr.blo) / pr.bdz
+    c = int(u)
+    m = pr.bidx.size
+    if c > m - 2:
+        c = m - 2
+    f = pr.bidx[c] + (u - c) * (pr.bidx[c + 1] - pr.bidx[c])
+    j = int(f)
+    if j > n - 2:
+        j = n - 2
+    while j > 0 and xn[j] > x:
+        j -= 1
+    while j < n - 2 and xn[j + 1] < x:
+        j += 1
+    return j
+
+
+@njit(cache=True, inline="always")
+def first_row(pr, j):
+    """First of the four rows j0..j0+3 used around interval j (clamped to the grid)."""
+    j0 = j - 1
+    if j0 < 0:
+        j0 = 0
+    if j0 > pr.xn.size - 4:
+        j0 = pr.xn.size - 4
+    return j0
+
+
+@njit(cache=True, inline="always")
+def stencil(pr, x0):
+    """(j0, w0, w1, w2, w3): 4-point Lagrange weights of x0 over rows j0..j0+3 (j0 = -1:
+    outside the rows)."""
+    j = _locate(pr, x0)
+    if j < 0:
+        return -1, 0.0, 0.0, 0.0, 0.0
+    j0 = first_row(pr, j)
+    a, b, c, d = pr.xn[j0], pr.xn[j0 + 1], pr.xn[j0 + 2], pr.xn[j0 + 3]
+    w0 = (x0 - b) * (x0 - c) * (x0 - d) / ((a - b) * (a - c) * (a - d))
+    w1 = (x0 - a) * (x0 - c) * (x0 - d) / ((b - a) * (b - c) * (b - d))
+    w2 = (x0 - a) * (x0 - b) * (x0 - d) / ((c - a) * (c - b) * (c - d))
+    w3 = (x0 - a) * (x0 - b) * (x0 - c) / ((d - a) * (d - b) * (d - c))
+    return j0, w0, w1, w2, w3
+
+
+@njit(cache=True, inline="always")
+def row_value(arr, st):
+    """Σ_r w_r arr[j0 + r] of a per-row array."""
+    j0 = st[0]
+    return st[1] * arr[j0] + st[2] * arr[j0 + 1] + st[3] * arr[j0 + 2] + st[4] * arr[j0 + 3]
+
+
+@njit(cache=True, inline="always")
+def _cell(pr, st, k):
+    """Quintic Hermite coefficients (y0, d0, s0, y1, d1, s1) of the x0-combined ln T on
+    z interval k."""
+    j0, w0, w1, w2, w3 = st
+    C = pr.C
+    k1 = k + 1
+    y0 = w0 * C[j0, k, 0] + w1 * C[j0 + 1, k, 0] + w2 * C[j0 + 2, k, 0] + w3 * C[j0 + 3, k, 0]
+    d0 = w0 * C[j0, k, 1] + w1 * C[j0 + 1, k, 1] + w2 * C[j0 + 2, k, 1] + w3 * C[j0 + 3, k, 1]
+    s0 = w0 * C[j0, k, 2] + w1 * C[j0 + 1, k, 2] + w2 * C[j0 + 2, k, 2] + w3 * C[j0 + 3, k, 2]
+    y1 = w0 * C[j0, k1, 0] + w1 * C[j0 + 1, k1, 0] + w2 * C[j0 + 2, k1, 0] + w3 * C[j0 + 3, k1, 0]
+    d1 = w0 * C[j0, k1, 1] + w1 * C[j0 + 1, k1, 1] + w2 * C[j0 + 2, k1, 1] + w3 * C[j0 + 3, k1, 1]
+    s1 = w0 * C[j0, k1, 2] + w1 * C[j0 + 1, k1, 2] + w2 * C[j0 + 2, k1, 2] + w3 * C[j0 + 3, k1, 2]
+    return y0, d0, s0, y1, d1, s1
+
+
+
+
+@njit(cache=True, inline="always")
+def _quintic(t, h, cf):
+    """(value, d/dz) of the quintic Hermite with coefficients cf at t = (z - z_k)/h."""
+    y0, d0, s0, y1, d1, s1 = cf
+    return quintic_unit(t, h, y0, d0, s0, y1, d1, s1)
+
+
+
+@njit(cache=True, inline="always")
+def _tail_T(pr, v):
+    """T at v >= v_ext: ∫_v^∞ dv'/σ̄_tail (closed form, π_c/π0 < e^-40 neglected)."""
+    return qk._tail_int(pr.c, v + pr.d, math.inf)
+
+
+@njit(cache=True, inline="always")
+def _tail_v(pr, T):
+    """Inverse of _tail_T: v with _tail_T(v) = T (T > 0)."""
+    if pr.c == 0.0:
+        a2 = 0.5 / T
+    else:
+        a2 = pr.c / -math.expm1(-2.0 * pr.c * T)
+    return math.sqrt(a2) - pr.d
+
+
+@njit(cache=True, inline="always")
+def _below(pr, st):
+    """(T0, h0, S) at the bottom of the z grid for the combined rows."""
+    cf = _cell(pr, st, 0)
+    l0, dl0 = _quintic(0.0, pr.dz, cf)
+    T0 = math.exp(l0)
+    return T0, -T0 * dl0, row_value(pr.sx, st)
+
+
+@njit(cache=True, inline="always")
+def t_of_z(pr, st, vinf, z):
+    """T(x0, v) at z = ln(v/v∞ - 1) for the stencil st of x0 (v∞ = vinf)."""
+    v = vinf * (1.0 + math.exp(z))
+    if v >= pr.v_ext:
+        return _tail_T(pr, v)
+    z = z + row_value(pr.lk, st)
+    if z < pr.z0:
+        T0, h0, S = _below(pr, st)
+        return T0 + S * (pr.z0 - z) - (h0 - S) * math.expm1(z - pr.z0)
+    k = int((z - pr.z0) / pr.dz)
+    if k > pr.nz - 2:
+        k = pr.nz - 2
+    t = (z - (pr.z0 + k * pr.dz)) / pr.dz
+    return math.exp(_quintic(t, pr.dz, _cell(pr, st, k))[0])
+
+
+@njit(cache=True, inline="always")
+def z_of_t(pr, st, vinf, T):
+    """z = ln(v/v∞ - 1) with T(x0, v) = T (inverse of t_of_z; T = inf gives -inf)."""
+    if T == math.inf:
+        return -math.inf
+    if not (T > 0.0):
+        return math.inf
+    if T <= _tail_T(pr, pr.v_ext):
+        return math.log(_tail_v(pr, T) / vinf - 1.0)
+    lk = row_value(pr.lk, st)
+    T0, h0, S = _below(pr, st)
+    if T >= T0:
+        z = pr.z0 - (T - T0) / h0
+        for _ in range(30):  # Newton on the analytic part below the grid
+            f = T0 + S * (pr.z0 - z) - (h0 - S) * math.expm1(z - pr.z0) - T
+            fp = -S - (h0 - S) * math.exp(z - pr.z0)
+            dzn = f / fp
+            z -= dzn
+            if abs(dzn) <= 1e-13 * (1.0 + abs(z)):  # beyond the round-off of T: would stall
+                break
+        return z - lk
+    lt = math.log(T)
+    # bracket: combined ln T at the nodes decreases with k
+    lo = 0
+    hi = pr.nz - 1
+    y_lo = row_value_2(pr.C, st, lo)
+    y_hi = row_value_2(pr.C, st, hi)
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        y_mid = row_value_2(pr.C, st, mid)
+        if y_mid >= lt:
+            lo = mid
+            y_lo = y_mid
+        else:
+            hi = mid
+            y_hi = y_mid
+    cf = _cell(pr, st, lo)
+    a, b = 0.0, 1.0
+    # start from the chord, then safeguarded Newton on the combined quintic; |Δt| <= 1e-13
+    # (Δz <= 2.5e-14) ends it: quadratic convergence makes the last step's error far smaller,
+    # and asking for less than the round-off of ln T (~1e-15 |ln T| / |d ln T/dt|) would
+    # only stall the iteration in bisection
+    t = (y_lo - lt) / (y_lo - y_hi) if y_lo > y_hi else 0.5
+    if not (0.0 < t < 1.0):
+        t = 0.5
+    for _ in range(60):
+        val, der = _quintic(t, pr.dz, cf)
+        f = val - lt
+        if f == 0.0:
+            break
+        if f > 0.0:
+            a = t
+        else:
+            b = t
+        tn = t - f / (der * pr.dz) if der != 0.0 else 0.5 * (a + b)
+        if not (a < tn < b):
+            tn = 0.5 * (a + b)
+        if abs(tn - t) <= 1e-13 or b - a <= 1e-13:
+            t = tn
+            break
+        t = tn
+    return pr.z0 + (lo + t) * pr.dz - lk
+
+
+@njit(cache=True, inline="always")
+def row_value_2(C, st, k):
+    """Σ_r w_r ln T[j0 + r, k] (the combined ln T at node k)."""
+    j0 = st[0]
+    return (st[1] * C[j0, k, 0] + st[2] * C[j0 + 1, k, 0] + st[3] * C[j0 + 2, k, 0]
+            + st[4] * C[j0 + 3, k, 0])
+
