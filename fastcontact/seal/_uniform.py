@@ -1,5 +1,5 @@
 """Flat-ring driver of :func:`fastcontact.seal.seal_leak` (private): validation, then one
-parallel numba pass (:func:`fastcontact.seal._sigma.uniform_rows`) writing every result column.
+parallel numba pass (:func:`fastcontact.seal._leak.uniform_rows`) writing every result column.
 
 Lorenz & Persson (2010), eq. (32) with the fluid feedback p0 = p_cont + p_f (28), for a
 uniform nominal pressure: q = (1/L) ∫_{p0−p_a}^{p0−p_b} σ_eff(p) dp.
@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from .._core.validate import check_positive
-from . import _sigma
+from . import _leak
 
 __all__ = ["leak_uniform", "ECHO"]
 
@@ -76,8 +76,8 @@ def leak_uniform(sc, theory, p0, L, com, alpha_cj):
     lift = np.empty(n, dtype=np.bool_)
     perc = np.empty(n, dtype=np.bool_)
     open_in = np.empty(n)
-    _sigma.uniform_rows(sc.tab, sc.rec, *flat, theory == "critical_junction",
-                        float(sc.alpha_table), Q, st, p_a, lift, perc, open_in, echo, need)
+    _leak.uniform_rows(sc.tab, sc.rec, *flat, theory == "critical_junction",
+                       float(sc.alpha_table), Q, st, p_a, lift, perc, open_in, echo, need)
     cols = {name: (echo[j] if need[j] else flat[j]) for j, name in enumerate(ECHO)}
     cols.update(Q=Q, lift_off=lift, percolated=perc, status=st, p_a=p_a, open_inlet=open_in,
                 open_outlet=np.zeros(n))
