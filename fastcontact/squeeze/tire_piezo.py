@@ -27,7 +27,7 @@ import pandas as pd
 from numba import njit, prange
 
 from .api import STATUS_NAMES
-from .viscosity import (DEFAULT_P_START, _lnv_of_lnp, _rate_factor, _scalars, _segment, _state,
+from .viscosity import (_lnv_of_lnp, _rate_factor, _scalars, _segment, _start, _state,
                         _target_times)
 
 __all__ = ["QUAD_ORDER", "QUAD_WIDTH", "STATUS", "barus_tire_columns"]
@@ -98,10 +98,7 @@ def _tire_kernel(tab, sc, p0, E, R, eta, alpha, us, t_fp, h, vt_ratio, vt_dv, gl
         if not (sc[0] <= x0 <= sc[5]):
             status[i] = _OUT
             continue
-        vinf = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0))
-        vs = us[i] / h
-        if vs != vs:
-            vs = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0 + math.log(DEFAULT_P_START)))
+        vinf, vs = _start(tab, sc, x0, us[i], h)
         uinf[i] = vinf * h
         ustart[i] = vs * h
         trapped = x0 >= sc[4]

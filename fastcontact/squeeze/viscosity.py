@@ -153,6 +153,17 @@ def _lnv_of_lnp(tab, x_min, v_top, u0, x):
 
 
 @njit(cache=True)
+def _start(tab, sc, x0, u_start, h):
+    """(v∞, v_start) = (ū∞, ū_start)/h_rms at ln(p0/E*) = x0; u_start [m] NaN: the default
+    start, where p_cont = DEFAULT_P_START·p0."""
+    vinf = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0))
+    vs = u_start / h
+    if vs != vs:
+        vs = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0 + math.log(DEFAULT_P_START)))
+    return vinf, vs
+
+
+@njit(cache=True)
 def _integrand(tab, sc, x0, api, vinf, w):
     """dt̃/dw at w = ln(v - v∞): (v - v∞)/(σ̄ d g(api d)), d = 1 - π_c/π0; 0 if σ̄ = 0."""
     e = math.exp(w)
@@ -221,10 +232,7 @@ def _piezo_kernel(tab, sc, p0, E, R, eta, alpha, us, h, vt_ratio, vt_dv, glx, gl
             for k in range(nt):
                 T[k, i] = math.nan
             continue
-        vinf = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0))
-        vs = us[i] / h
-        if vs != vs:
-            vs = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0 + math.log(DEFAULT_P_START)))
+        vinf, vs = _start(tab, sc, x0, us[i], h)
         uinf[i] = vinf * h
         ustart[i] = vs * h
         api = alpha[i] * p0[i]
@@ -326,17 +334,7 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     alpha_pv = check_positive("alpha_pv", alpha_pv, "[1/Pa]", allow_zero=True)
     us = np.array(np.nan) if u_start is None else check_positive("u_start", u_start, "[m]",
                                                                     allow_inf=False)
-    ratios = np.atleast_1d(np.asarray(ratios, dtype=np.float64)).ravel()
-    if ratios.size and not np.all(np.isfinite(ratios) & (ratios > 1.0)):
-        raise ValueError(f"ratios = {ratios.tolist()!r} is invalid: every ratio must be a "
-                         f"finite number > 1 [-]")
-    du = np.atleast_1d(np.asarray(du, dtype=np.float64)).ravel()
-    if du.size:
-        check_positive("du", du, "[m]")
-    qo = int(quad_order)
-    if not 2 <= qo <= 64:
-        raise ValueError(f"quad_order = {quad_order!r} is invalid: must be an integer in [2, 64]")
-    width = float(check_positive("quad_width", quad_width, "[-]"))
+    ratios, du, qo, width = _check_targets(ratios, du, quad_order, quad_width)
     shape = np.broadcast(p0, E_star, R, eta, alpha_pv, us).shape
     flat = [np.ascontiguousarray(np.broadcast_to(a, shape).ravel(), dtype=np.float64)
             for a in (p0, E_star, R, eta, alpha_pv, us)]
@@ -357,6 +355,27 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
             i = int(np.flatnonzero(bad)[0])
             raise ValueError(f"u_start = {flat[5][i]!r} is invalid: must be > u_inf = "
                              f"{uinf[i]!r} [m]")
+    return _piezo_frame(flat, ratios, du, T, uinf, ustart, tau0, gs, status, theory)
+
+
+def _check_targets(ratios, du, quad_order, quad_width):
+    """(ratios, du [m], quadrature order, panel width) of :func:`squeeze_out_piezo`, checked."""
+    ratios = np.atleast_1d(np.asarray(ratios, dtype=np.float64)).ravel()
+    if ratios.size and not np.all(np.isfinite(ratios) & (ratios > 1.0)):
+        raise ValueError(f"ratios = {ratios.tolist()!r} is invalid: every ratio must be a "
+                         f"finite number > 1 [-]")
+    du = np.atleast_1d(np.asarray(du, dtype=np.float64)).ravel()
+    if du.size:
+        check_positive("du", du, "[m]")
+    qo = int(quad_order)
+    if not 2 <= qo <= 64:
+        raise ValueError(f"quad_order = {quad_order!r} is invalid: must be an integer in [2, 64]")
+    width = float(check_positive("quad_width", quad_width, "[-]"))
+    return ratios, du, qo, width
+
+
+def _piezo_frame(flat, ratios, du, T, uinf, ustart, tau0, gs, status, theory):
+    """The result DataFrame of :func:`squeeze_out_piezo` from the kernel outputs."""
     cols = {"p0": flat[0], "E_star": flat[1], "R": flat[2], "eta": flat[3],
             "alpha_pv": flat[4], "u_start": ustart, "u_inf": uinf, "t_star": T[0]}
     for k, r in enumerate(ratios):
