@@ -65,19 +65,27 @@ def grade_inverse(u, m):
 
 
 @njit(cache=True)
+def _bisect(a, hi, x):
+    """Index k in [0, hi) with a[k] <= x < a[k+1] by bisection (a ascending; 0 below a[1],
+    hi − 1 at and above a[hi − 1])."""
+    lo = 0
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if a[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True)
 def interp_linear(xg, pg, x):
     n = xg.size
     if x <= xg[0]:
         return pg[0], 0
     if x >= xg[n - 1]:
         return pg[n - 1], n - 2
-    lo, hi = 0, n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if xg[mid] <= x:
-            lo = mid
-        else:
-            hi = mid
+    lo = _bisect(xg, n - 1, x)
     return pg[lo] + (pg[lo + 1] - pg[lo]) * (x - xg[lo]) / (xg[lo + 1] - xg[lo]), lo
 
 
@@ -235,13 +243,7 @@ def panel_series(r, pan, P, n, Lp, coef, after):
 @njit(cache=True)
 def _panel_at(t, pan, P):
     """(panel p with pan[p] <= t < pan[p+1], local Legendre variable z ∈ [-1, 1]) by bisection."""
-    lo, hi = 0, P
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if pan[mid] <= t:
-            lo = mid
-        else:
-            hi = mid
+    lo = _bisect(pan, P, t)
     return lo, (t - pan[lo]) / (0.5 * (pan[lo + 1] - pan[lo])) - 1.0
 
 

@@ -158,6 +158,82 @@ def _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, ftol,
 
 
 @njit(cache=True)
+def _node_arrays(N):
+    """Work arrays of a mesh of N nodes: t, ξ, dξ/dt, e_a, e_b, then (c, r, D, R̃, F) twice
+    (Newton's current and trial states) and the two right-hand sides y1, y2."""
+    return (np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N),
+            np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N),
+            np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N))
+
+
+@njit(cache=True)
+def _first_guess(kind, gp, xg, pg, m, pia, pib, dpi, xi, eb, N, cperc, init_P, init_s, c):
+    """Initial contact pressure c at the N nodes: c = e_b − Δπ s with s = init_s
+    (continuation, init_P > 0) or the fluid pressure linear in ξ across the zone, capped
+    below percolation. Returns the Newton tolerance on F (1e-13 of the pressure scale)."""
+    scale = dpi
+    for i in range(N):
+        scale = max(scale, abs(eb[i]))
+    g0 = geometry(kind, gp, xg, pg, 0.0, m, pia, pib)[0]
+    g1 = geometry(kind, gp, xg, pg, 1.0, m, pia, pib)[0]
+    for i in range(N):
+        if init_P > 0:
+            s = init_s[i]
+        else:
+            s = (g1 - xi[i]) / (g1 - g0) if g1 > g0 else 0.5
+        ci = eb[i] - dpi * s
+        if ci > 0.9 * cperc and init_P == 0:
+            ci = 0.9 * cperc
+        c[i] = ci
+    return 1e-13 * scale
+
+
+@njit(cache=True)
+def _indicator(r, pan, P, n, Lp, coef, after, W, tol, err):
+    """Error indicator per panel (Legendre tail of r relative to W) into err; returns (number
+    of panels above tol, sum of the indicators). Leaves r's panel series in coef/after."""
+    panel_series(r, pan, P, n, Lp, coef, after)
+    nsplit = 0
+    est = 0.0
+    for p in range(P):
+        e = (abs(coef[p, n - 1]) + abs(coef[p, n - 2])) * (pan[p + 1] - pan[p]) / W
+        err[p] = e
+        est += e
+        if e > tol:
+            nsplit += 1
+    return nsplit, est
+
+
+@njit(cache=True)
+def _series_at_nodes(pan_new, P_new, zl, n, pan, P, coef, after, W, Pk, remaining, out):
+    """At the Gauss–Legendre nodes of the mesh pan_new (P_new panels), the converged
+    solution's remaining fraction s(t) (``remaining``) or its series of r (coef) into out."""
+    for p in range(P_new):
+        tl = pan_new[p]
+        tr = pan_new[p + 1]
+        for k in range(n):
+            tt = tl + 0.5 * (tr - tl) * (zl[k] + 1.0)
+            if remaining:
+                out[p * n + k] = remaining_fraction(tt, pan, P, n, coef, after, W, Pk)
+            else:
+                out[p * n + k] = interp_series(tt, pan, P, n, coef, Pk)
+
+
+@njit(cache=True)
+def _halve(pan, P, err, tol, pan2):
+    """pan2: the mesh pan with every panel whose err exceeds tol halved; returns its panels."""
+    q = 0
+    for p in range(P):
+        pan2[q] = pan[p]
+        q += 1
+        if err[p] > tol:
+            pan2[q] = 0.5 * (pan[p] + pan[p + 1])
+            q += 1
+    pan2[q] = 1.0
+    return q
+
+
+@njit(cache=True)
 def solve_case(tab, sc, rule, tol, maxit, kind, gp, xg, pg, pia, pib, pan_out, c_out, r_out,
                init_P, init_pan, init_s, s_out):
     """Solve one soft seal on its sealing zone (see the module docstring).
@@ -173,24 +249,7 @@ def solve_case(tab, sc, rule, tol, maxit, kind, gp, xg, pg, pia, pib, pan_out, c
     m, n, P0, PMAX = rule.m, rule.n, rule.P0, rule.PMAX
     zl, wl, At, Lp = rule.zl, rule.wl, rule.At, rule.Lp
     dpi = pia - pib
-    NMAX = PMAX * n
-    t = np.empty(NMAX)
-    xi = np.empty(NMAX)
-    dxi = np.empty(NMAX)
-    ea = np.empty(NMAX)
-    eb = np.empty(NMAX)
-    c = np.empty(NMAX)
-    r = np.empty(NMAX)
-    D = np.empty(NMAX)
-    Rt = np.empty(NMAX)
-    F = np.empty(NMAX)
-    c2 = np.empty(NMAX)
-    r2 = np.empty(NMAX)
-    D2 = np.empty(NMAX)
-    Rt2 = np.empty(NMAX)
-    F2 = np.empty(NMAX)
-    y1 = np.empty(NMAX)
-    y2 = np.empty(NMAX)
+    t, xi, dxi, ea, eb, c, r, D, Rt, F, c2, r2, D2, Rt2, F2, y1, y2 = _node_arrays(PMAX * n)
     Y = np.empty((n, 2))
     K = np.empty((n, n))
     Pk = np.empty(n + 1)
@@ -199,33 +258,12 @@ def solve_case(tab, sc, rule, tol, maxit, kind, gp, xg, pg, pia, pib, pan_out, c
     pan = np.empty(PMAX + 1)
     pan2 = np.empty(PMAX + 1)
     err = np.empty(PMAX)
-    if init_P > 0:
-        P = init_P
-        for p in range(P + 1):
-            pan[p] = init_pan[p]
-    else:
-        P = P0
-        for p in range(P + 1):
-            pan[p] = p / P
+    P = init_P if init_P > 0 else P0
+    for p in range(P + 1):
+        pan[p] = init_pan[p] if init_P > 0 else p / P
     _fill_nodes(kind, gp, xg, pg, m, pia, pib, zl, pan, P, n, t, xi, dxi, ea, eb)
-    N = P * n
-    scale = dpi
-    for i in range(N):
-        scale = max(scale, abs(eb[i]))
-    ftol = 1e-13 * scale
-    # initial guess: fluid pressure linear in ξ across the zone, capped below percolation
-    g0 = geometry(kind, gp, xg, pg, 0.0, m, pia, pib)[0]
-    g1 = geometry(kind, gp, xg, pg, 1.0, m, pia, pib)[0]
-    cperc = sc.p_perc
-    for i in range(N):
-        if init_P > 0:
-            s = init_s[i]
-        else:
-            s = (g1 - xi[i]) / (g1 - g0) if g1 > g0 else 0.5
-        ci = eb[i] - dpi * s
-        if ci > 0.9 * cperc and init_P == 0:
-            ci = 0.9 * cperc
-        c[i] = ci
+    ftol = _first_guess(kind, gp, xg, pg, m, pia, pib, dpi, xi, eb, P * n, sc.p_perc, init_P,
+                        init_s, c)
     status = ST_OK
     total_it = 0
     est = math.inf
@@ -238,16 +276,7 @@ def solve_case(tab, sc, rule, tol, maxit, kind, gp, xg, pg, pia, pib, pan_out, c
         if not conv:
             status = ST_NEWTON_FAILED
             break
-        # error indicator per panel: Legendre tail of r, relative to W
-        panel_series(r, pan, P, n, Lp, coef, after)
-        nsplit = 0
-        est = 0.0
-        for p in range(P):
-            e = (abs(coef[p, n - 1]) + abs(coef[p, n - 2])) * (pan[p + 1] - pan[p]) / W
-            err[p] = e
-            est += e
-            if e > tol:
-                nsplit += 1
+        nsplit, est = _indicator(r, pan, P, n, Lp, coef, after, W, tol, err)
         if nsplit == 0 or P + nsplit > PMAX:
             if nsplit > 0:
                 status = ST_NOT_REFINED
@@ -258,39 +287,66 @@ def solve_case(tab, sc, rule, tol, maxit, kind, gp, xg, pg, pia, pib, pan_out, c
             if not conv:
                 status = ST_NEWTON_FAILED
             break
-        q = 0
-        for p in range(P):
-            pan2[q] = pan[p]
-            q += 1
-            if err[p] > tol:
-                pan2[q] = 0.5 * (pan[p] + pan[p + 1])
-                q += 1
-        pan2[q] = 1.0
-        Pn = q
+        Pn = _halve(pan, P, err, tol, pan2)
         # new nodes: remaining fraction s(t) of the converged solution, then c = e_b − Δπ s
-        for p in range(Pn):
-            tl = pan2[p]
-            tr = pan2[p + 1]
-            for k in range(n):
-                tt = tl + 0.5 * (tr - tl) * (zl[k] + 1.0)
-                y1[p * n + k] = remaining_fraction(tt, pan, P, n, coef, after, W, Pk)
+        _series_at_nodes(pan2, Pn, zl, n, pan, P, coef, after, W, Pk, True, y1)
         for p in range(Pn + 1):
             pan[p] = pan2[p]
         P = Pn
-        N = P * n
         _fill_nodes(kind, gp, xg, pg, m, pia, pib, zl, pan, P, n, t, xi, dxi, ea, eb)
-        for i in range(N):
+        for i in range(P * n):
             c[i] = eb[i] - dpi * y1[i]
-    N = P * n
-    for p in range(P + 1):
-        pan_out[p] = pan[p]
-    for i in range(N):
-        c_out[i] = c[i]
-        r_out[i] = r[i]
-    if s_out.size >= N:
-        for i in range(N):
+    _copy_mesh(P, n, pan, c, r, pan_out, c_out, r_out)
+    if s_out.size >= P * n:
+        for i in range(P * n):
             s_out[i] = (eb[i] - c[i]) / dpi
     return W, status, P, est, total_it
+
+
+@njit(cache=True)
+def _copy_mesh(P, n, pan, c, r, pan_out, c_out, r_out):
+    """The mesh (P panels of n nodes), c and r into the output arrays."""
+    for p in range(P + 1):
+        pan_out[p] = pan[p]
+    for i in range(P * n):
+        c_out[i] = c[i]
+        r_out[i] = r[i]
+
+
+@njit(cache=True)
+def _continuation(cperc, pmax, pia, pib):
+    """(ok, p_a0, δ0, δ_T) of the continuation in p_a: its start p_a0 where the peak contact
+    pressure max p0 − p_a is 0.6 p_perc (δ = p_perc − (max p0 − p_a) from δ0 down to its
+    target δ_T), or halfway in p_a without percolation; ok False if no easier start exists."""
+    if cperc < math.inf:
+        dT = cperc - (pmax - pia)
+        d0 = max(dT, 0.4 * cperc, cperc - pmax + pib + 0.5 * (pia - pib))
+        if not d0 > dT:
+            return False, 0.0, d0, dT
+        return True, pmax - cperc + d0, d0, dT
+    return True, pib + 0.5 * (pia - pib), 0.0, 0.0
+
+
+@njit(cache=True)
+def _refine_previous(r_prev, pan, P, n, Lp, zl, PMAX, W_prev, coef, after, Pk, pan_new, s_new,
+                     rr):
+    """After a failed continuation step: halve the previous solution's panels where its
+    resistance concentrates (the peak sharpens as δ falls and the Newton needs it resolved);
+    if that adds panels (within PMAX), its remaining fraction into s_new and its r (by
+    interpolation) into rr on the new mesh pan_new. Returns the new panel count."""
+    panel_series(r_prev, pan, P, n, Lp, coef, after)
+    q = 0
+    for p in range(P):
+        pan_new[q] = pan[p]
+        q += 1
+        if (pan[p + 1] - pan[p]) * coef[p, 0] > 0.02 * W_prev and q < PMAX:
+            pan_new[q] = 0.5 * (pan[p] + pan[p + 1])
+            q += 1
+    pan_new[q] = 1.0
+    if q > P and q <= PMAX:
+        _series_at_nodes(pan_new, q, zl, n, pan, P, coef, after, W_prev, Pk, True, s_new)
+        _series_at_nodes(pan_new, q, zl, n, pan, P, coef, after, W_prev, Pk, False, rr)
+    return q
 
 
 @njit(cache=True)
@@ -311,14 +367,9 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, pan_out, c_o
     if st != ST_NEWTON_FAILED:
         return W, st, P, est, its, 0
     cperc = sc.p_perc
-    if cperc < math.inf:
-        dT = cperc - (pmax - pia)
-        d0 = max(dT, 0.4 * cperc, cperc - pmax + pib + 0.5 * (pia - pib))
-        if not d0 > dT:
-            return W, st, P, est, its, 0
-        pa0 = pmax - cperc + d0
-    else:
-        pa0 = pib + 0.5 * (pia - pib)
+    ok, pa0, d0, dT = _continuation(cperc, pmax, pia, pib)
+    if not ok:
+        return W, st, P, est, its, 0
     NMAX = PMAX * n
     pan = np.empty(PMAX + 1)
     sn = np.empty(NMAX)
@@ -345,10 +396,7 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, pan_out, c_o
     while lam < 1.0 and steps < 80 and its < 4000:
         steps += 1
         lt = min(1.0, lam + step)
-        if cperc < math.inf:
-            pa = pmax - cperc + d0 * (dT / d0) ** lt
-        else:
-            pa = pa0 + lt * (pia - pa0)
+        pa = pmax - cperc + d0 * (dT / d0) ** lt if cperc < math.inf else pa0 + lt * (pia - pa0)
         if lt == 1.0:
             pa = pia
         zone_params(kind, base, xg, pg, pa, pib, gp)
@@ -357,38 +405,12 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, pan_out, c_o
                                             s_new)
         its += it2
         if st2 == ST_NEWTON_FAILED:
-            # first refine the previous solution where its resistance concentrates (the peak
-            # sharpens as δ falls and the Newton needs it resolved), then shorten the step
-            panel_series(r_prev, pan, P, n, Lp, coef, after)
-            q = 0
-            for p in range(P):
-                pan_new[q] = pan[p]
-                q += 1
-                if (pan[p + 1] - pan[p]) * coef[p, 0] > 0.02 * W_prev and q < PMAX:
-                    pan_new[q] = 0.5 * (pan[p] + pan[p + 1])
-                    q += 1
-            pan_new[q] = 1.0
+            # first refine the previous solution, then shorten the step
+            q = _refine_previous(r_prev, pan, P, n, Lp, zl, PMAX, W_prev, coef, after, Pk,
+                                 pan_new, s_new, rr)
             if q > P and q <= PMAX:
-                for p in range(q):
-                    tl = pan_new[p]
-                    tr = pan_new[p + 1]
-                    for k in range(n):
-                        tt = tl + 0.5 * (tr - tl) * (zl[k] + 1.0)
-                        s_new[p * n + k] = remaining_fraction(tt, pan, P, n, coef, after,
-                                                              W_prev, Pk)
-                # the previous solution on the refined mesh: its r by interpolation
-                for p in range(q):
-                    tl = pan_new[p]
-                    tr = pan_new[p + 1]
-                    for k in range(n):
-                        tt = tl + 0.5 * (tr - tl) * (zl[k] + 1.0)
-                        rr[p * n + k] = interp_series(tt, pan, P, n, coef, Pk)
                 P = q
-                for p in range(P + 1):
-                    pan[p] = pan_new[p]
-                for i in range(P * n):
-                    sn[i] = s_new[i]
-                    r_prev[i] = rr[i]
+                _copy_mesh(P, n, pan_new, s_new, rr, pan, sn, r_prev)
                 continue
             step *= 0.5
             if step < 1e-3:
@@ -396,21 +418,13 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, pan_out, c_o
             continue
         lam = lt
         P = P2
-        for p in range(P + 1):
-            pan[p] = pan_new[p]
-        for i in range(P * n):
-            sn[i] = s_new[i]
-            r_prev[i] = rr[i]
+        _copy_mesh(P, n, pan_new, s_new, rr, pan, sn, r_prev)
         W, st, est = W2, st2, est2
         W_prev = W
         step = min(2.0 * step, 0.5)
     if lam < 1.0:
         return W, ST_NEWTON_FAILED, P, est, its, steps
-    for p in range(P + 1):
-        pan_out[p] = pan[p]
-    for i in range(P * n):
-        c_out[i] = cc[i]
-        r_out[i] = rr[i]
+    _copy_mesh(P, n, pan, cc, rr, pan_out, c_out, r_out)
     return W, st, P, est, its, steps
 
 
