@@ -2,6 +2,16 @@
 
 Lorenz & Persson (2010), Sec. 6, eqs. (25)–(33): steady flow across the seal width with the
 fluid pressure feeding back on the contact pressure, p0 = p_cont + p_f (28).
+
+Flat ring: q = (1/L) ∫_{p0−p_a}^{p0−p_b} σ_eff(p) dp (eq. 33 with uniform p0), from a tabulated
+primitive whose short intervals are integrated directly — never a difference of two large
+primitives; relative error <= 1e-7 against direct quadrature. The tables verify σ̄ only down
+to their floor (``tables.info["sigma_floor"]``): past π_trust, just below the percolation
+pressure ("average" is verified everywhere), σ̄ may be off by orders of magnitude. There Q
+uses the bound 0 <= σ̄ <= σ̄(π_trust) and reports the midpoint when the bound moves Q by less
+than 1e-9 (``_sigma.TAIL_RTOL``), else Q = NaN with status "near_percolation" (e.g. dp << p0
+with p0 − p_b just below the percolation pressure). Hertz and arrays: eq. (33) on adaptive
+Gauss–Legendre panels by damped Newton.
 """
 from __future__ import annotations
 
@@ -210,18 +220,14 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
     ----------
     tables : fastcontact.tables.Tables
         Precomputed tables of the rough surface (must hold ``theory``).
-    p0 : float or array_like, optional
-        Nominal contact pressure of a flat ring [Pa] (``profile="uniform"``).
+    p0, L : float or array_like, optional
+        Flat ring (``profile="uniform"``): nominal contact pressure [Pa] and seal width [m].
     dp : float or array_like
         Pressure difference p_a − p_b across the seal [Pa], >= 0.
-    L : float or array_like, optional
-        Seal width [m] (``profile="uniform"``).
     L_y : float or array_like
         Seal length, e.g. the mean circumference of a ring [m].
-    E_star : float or array_like
-        Effective modulus [Pa].
-    eta : float or array_like
-        Fluid viscosity [Pa·s].
+    E_star, eta : float or array_like
+        Effective modulus [Pa] and fluid viscosity [Pa·s].
     theory : {"critical_junction", "emt", "average"}, default DEFAULT_THEORY ("critical_junction")
         Flow-conductivity theory (must be in the tables).
     alpha_cj : float or array_like, default 1.0
@@ -240,58 +246,33 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
     solver : dict, optional
         Knobs of the non-uniform solver (``fastcontact.seal.SOLVER_DEFAULTS``).
     alpha_pv : float or array_like, default 0.0
-        Barus pressure–viscosity coefficient α [1/Pa], η = η0 exp(α(p_f − p_b)); any non-zero
-        value dispatches to :func:`fastcontact.seal.viscosity.seal_leak_piezo` ("uniform" and
-        "hertz" profiles). 0 leaves this function's result unchanged.
-    direction : {None, "x", "y"}, default None
-        Flow direction on tables built with ``precompute(..., anisotropy=γ_T)`` (issue 14):
-        "x" along the long correlation length (the grooves), "y" across; the engine then runs
-        on :func:`fastcontact.flow.anisotropy.tables_for_direction` (σ_xx or σ_yy of the
-        anisotropic effective medium, theory "emt"; "average" has no direction;
-        "critical_junction" raises ValueError). On isotropic tables every direction gives
-        exactly the result of None (σ_xx = σ_yy = σ).
+        Barus coefficient α [1/Pa], η = η0 exp(α(p_f − p_b)); 0 leaves the result unchanged.
     viscosity : {"barus", "roelands"}, default "barus"
-        Pressure–viscosity law. "roelands" dispatches to
-        :func:`fastcontact.seal.viscosity.seal_leak_piezo` (numerical Reynolds solution; the
-        reduced pressure does not apply), with ``roelands_z`` [-] (None: Z from ``alpha_pv``
-        as the initial slope), ``roelands_p_r`` [Pa] and ``roelands_eta_inf`` [Pa·s] (None:
-        Hamrock & Dowson's constants, :mod:`fastcontact.flow.piezoviscosity`).
+        Pressure–viscosity law. α_pv ≠ 0 or "roelands" dispatch to
+        :func:`fastcontact.seal.viscosity.seal_leak_piezo` ("uniform", "hertz"), which also
+        takes ``roelands_z`` [-], ``roelands_p_r`` [Pa] and ``roelands_eta_inf`` [Pa·s].
+    direction : {None, "x", "y"}, default None
+        Flow direction on tables built with ``precompute(..., anisotropy=γ_T)``: "x" along
+        the grooves, "y" across (σ_xx, σ_yy of the anisotropic medium, theory "emt"; "average"
+        has no direction, "critical_junction" raises); isotropic tables: the result of None.
 
     Returns
     -------
     pandas.DataFrame
-        One row per case: ``Q`` [m³/s]; ``lift_off`` (p_a >= max p0: at the equality Q is the
-        finite limit, beyond it Q = inf and ``status = "open"``); ``percolated`` (the contact
-        percolates somewhere across the width: Q = 0); ``status`` (``"ok"``, ``"lift_off"``,
-        ``"open"``, ``"percolated"``, ``"above_table"`` — contact pressure above the table,
-        Q = NaN —, ``"not_converged"`` — Q = NaN —, ``"near_percolation"`` — flat ring whose
-        contact pressure reaches the tables' unresolved tail, Q = NaN, see Notes); the
-        inputs; ``p_a`` [Pa];
-        ``open_inlet``/``open_outlet`` [m]; non-uniform profiles also ``converged`` and
-        ``error_estimate`` [-], Hertz ``a``, ``L`` [m], ``p_max`` [Pa]. ``df.attrs`` holds
-        ``shape``, ``theory``, ``profile``, ``units`` and ``references``.
-
-    Notes
-    -----
-    Flat ring: q = (1/L) ∫_{p0−p_a}^{p0−p_b} σ_eff(p) dp (eq. 33 with uniform p0), from a
-    tabulated primitive whose short intervals are integrated directly — never a difference of
-    two large primitives; relative error <= 1e-7 against direct quadrature. The tables verify
-    σ̄ only down to their floor (``tables.info["sigma_floor"]``, 1e-24): past the last node
-    above it, π_trust (just below the percolation pressure of "critical_junction" and "emt";
-    "average", σ̄ = (ū/h_rms)³, is verified through ū everywhere), σ̄ is an extrapolation
-    that can be off by tens of orders of magnitude. There Q uses the bound
-    0 <= σ̄ <= σ̄(π_trust) (σ̄ falls with p_cont) and reports the midpoint when the bound
-    moves Q by less than 1e-9 (``_sigma.TAIL_RTOL``); otherwise Q = NaN with status
-    ``"near_percolation"`` (e.g. dp << p0 with p0 − p_b just below the percolation
-    pressure). Hertz and arrays: eq. (33) on adaptive Gauss–Legendre panels by damped Newton.
+        Columns :func:`columns` of the profile kind: ``Q`` [m³/s]; ``lift_off`` (p_a >= max
+        p0: the finite limit at the equality, Q = inf beyond, ``status = "open"``);
+        ``percolated`` (Q = 0); ``status`` (:data:`STATUS`; Q = NaN for "above_table" — the
+        contact pressure above the table —, "not_converged" and "near_percolation", module
+        docstring); the inputs, ``p_a`` [Pa], ``open_inlet``/``open_outlet`` [m]; non-uniform
+        profiles ``converged``, ``error_estimate`` [-], Hertz ``a``, ``L`` [m], ``p_max`` [Pa].
+        ``attrs``: ``shape``, ``theory``, ``profile``, ``units``, ``references``.
 
     References
     ----------
     B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10621-2
     """
     if direction is not None:                  # issue 14: anisotropic roughness (σ_xx, σ_yy)
-        from ..flow.anisotropy import tables_for_direction
-        tables = tables_for_direction(check_tables(tables), direction, theory)
+        tables = _directional(tables, direction, theory)
     if viscosity != "barus" or np.any(np.asarray(alpha_pv, dtype=np.float64) != 0.0):
         return seal_leak_piezo(tables, p0=p0, dp=dp, L=L, L_y=L_y, E_star=E_star, eta=eta,
                                alpha_pv=alpha_pv, theory=theory, alpha_cj=alpha_cj, p_b=p_b,
@@ -301,28 +282,42 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
     check_tables(tables)
     al = align_inputs(p0=p0, dp=dp, L=L, L_y=L_y, E_star=E_star, eta=eta, p_b=p_b, R=R,
                       f_N=f_N)                               # pandas inputs paired by label
-    p0, dp, L, L_y, E_star, eta, p_b, R, f_N = (al[k] for k in ("p0", "dp", "L", "L_y", "E_star",
-                                                                 "eta", "p_b", "R", "f_N"))
     alpha_cj = check_theory_for(tables, theory, alpha_cj, a_perc)
     kind, p0x, xarr = profile_kind(profile, x)
-    com = common_inputs(dp, L_y, E_star, eta, p_b)
-    sc = seal_context(tables, theory)
-    if kind == "uniform":
-        require(kind, p0=p0, L=L)
-        if R is not None or f_N is not None:
-            name, v = ("R", R) if R is not None else ("f_N", f_N)
-            raise ValueError(f"{name} = {v!r} is invalid with profile = 'uniform': R and f_N "
-                             f"define the Hertz profile (profile='hertz')")
-        cols, shape = _leak_uniform(sc, theory, p0, L, com, alpha_cj)
-    elif kind == "hertz":
-        forbid(kind, p0=p0, L=L)
-        require(kind, R=R, f_N=f_N)
-        cols, shape = _leak_hertz(sc, theory, R, f_N, com, alpha_cj, solver_options(solver))
-    else:
-        forbid("array", p0=p0, L=L, R=R, f_N=f_N)
-        cols, shape = _leak_array(sc, theory, p0x, xarr, com, alpha_cj, solver_options(solver))
+    com = common_inputs(al["dp"], al["L_y"], al["E_star"], al["eta"], al["p_b"])
+    cols, shape = _leak_kind(seal_context(tables, theory), theory, kind, al, p0x, xarr, com,
+                             alpha_cj, solver)
+    return _frame(cols, shape, theory, kind)
+
+
+def _frame(cols, shape, theory, kind):
+    """The result DataFrame of :func:`seal_leak`: the columns of ``kind``, units, references."""
     names = _COLUMNS[kind]
     df = pd.DataFrame({c: cols[c] for c in names}, copy=False)
     df.attrs.update({"shape": tuple(shape), "theory": theory, "profile": kind,
                      "units": {c: UNITS[c] for c in names}, "references": list(REFERENCES)})
     return df
+
+
+def _directional(tables, direction, theory):
+    """The tables of σ_xx or σ_yy for ``direction`` (anisotropic roughness, issue 14)."""
+    from ..flow.anisotropy import tables_for_direction   # only for directional runs
+    return tables_for_direction(check_tables(tables), direction, theory)
+
+
+def _leak_kind(sc, theory, kind, al, p0x, xarr, com, alpha_cj, solver):
+    """(columns, shape) of :func:`seal_leak` for the profile ``kind``, after checking that the
+    arguments ``al`` (aligned inputs by name) fit it."""
+    if kind == "uniform":
+        require(kind, p0=al["p0"], L=al["L"])
+        if al["R"] is not None or al["f_N"] is not None:
+            name, v = ("R", al["R"]) if al["R"] is not None else ("f_N", al["f_N"])
+            raise ValueError(f"{name} = {v!r} is invalid with profile = 'uniform': R and f_N "
+                             f"define the Hertz profile (profile='hertz')")
+        return _leak_uniform(sc, theory, al["p0"], al["L"], com, alpha_cj)
+    if kind == "hertz":
+        forbid(kind, p0=al["p0"], L=al["L"])
+        require(kind, R=al["R"], f_N=al["f_N"])
+        return _leak_hertz(sc, theory, al["R"], al["f_N"], com, alpha_cj, solver_options(solver))
+    forbid("array", p0=al["p0"], L=al["L"], R=al["R"], f_N=al["f_N"])
+    return _leak_array(sc, theory, p0x, xarr, com, alpha_cj, solver_options(solver))
