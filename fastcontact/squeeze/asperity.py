@@ -140,6 +140,28 @@ def _level_results(psd, base, kw, z, p0, E_star, R, eta, theory, region, ratios)
             "trapped": (a_r >= a_thr) | df["trapped"].to_numpy(bool), "frame": df}
 
 
+def _level_row(res):
+    """One row of :func:`asperity_levels` from the single-case columns of
+    :func:`_level_results` (its squeeze-out frame's times [s] and separations [m] included)."""
+    r = res.pop("frame").iloc[0]
+    row = {k: (bool(v[0]) if k == "trapped" else float(v[0])) for k, v in res.items()}
+    row.update({"u_inf": r["u_inf"], "u_start": r["u_start"], "t_star": r["t_star"]})
+    for c in r.index:
+        if c.startswith("t_ratio_"):
+            row[c] = r[c]
+    row.update({"t_relax": r["t_relax"], "out_of_table": bool(r["out_of_table"])})
+    return row
+
+
+def _level_units(columns):
+    """Units of the :func:`asperity_levels` columns (every ``t_*`` column in s)."""
+    units = {"zeta": "1", "q_min": "1/m", "area_fraction": "1", "p_zeta": "Pa", "R_zeta": "m",
+             "h_rms_zeta": "m", "area_restricted": "1", "area_threshold": "1", "u_inf": "m",
+             "u_start": "m"}
+    units.update({c: "s" for c in columns if c.startswith("t_")})
+    return units
+
+
 def asperity_levels(psd=None, *, p0, E_star, R, eta, theory="emt", level_ratio=2.0,
                     zetas=None, zeta_max=None, region=None, ratios=(1.1,), tables_kwargs=None,
                     tables=None):
@@ -198,26 +220,15 @@ def asperity_levels(psd=None, *, p0, E_star, R, eta, theory="emt", level_ratio=2
     region = region_radius if region is None else region
     rows = []
     for z in zs:
-        res = _level_results(psd, tables, kw, float(z), np.array([p0]), np.array([E_star]),
-                             np.array([R]), np.array([eta]), theory, region, ratios)
-        r = res.pop("frame").iloc[0]
-        row = {k: (bool(v[0]) if k == "trapped" else float(v[0])) for k, v in res.items()}
-        row.update({"u_inf": r["u_inf"], "u_start": r["u_start"], "t_star": r["t_star"]})
-        for c in r.index:
-            if c.startswith("t_ratio_"):
-                row[c] = r[c]
-        row.update({"t_relax": r["t_relax"], "out_of_table": bool(r["out_of_table"])})
-        rows.append(row)
+        rows.append(_level_row(_level_results(
+            psd, tables, kw, float(z), np.array([p0]), np.array([E_star]), np.array([R]),
+            np.array([eta]), theory, region, ratios)))
     out = pd.DataFrame(rows)
     t = np.where(out["trapped"], np.inf, out["t_star"].to_numpy(dtype=float))
     out["t_sequential"] = np.cumsum(t)
     out["t_parallel"] = np.maximum.accumulate(t)
     trapped = out["zeta"][out["trapped"]]
-    units = {"zeta": "1", "q_min": "1/m", "area_fraction": "1", "p_zeta": "Pa", "R_zeta": "m",
-             "h_rms_zeta": "m", "area_restricted": "1", "area_threshold": "1", "u_inf": "m",
-             "u_start": "m"}
-    units.update({c: "s" for c in out.columns if c.startswith("t_")})
-    out.attrs.update({"units": units, "theory": theory, "level_ratio": lr,
+    out.attrs.update({"units": _level_units(out.columns), "theory": theory, "level_ratio": lr,
                       "zeta_trap": float(trapped.iloc[0]) if trapped.size else math.inf,
                       "region_rule": getattr(region, "__name__", repr(region)),
                       "level_options": dict(kw),

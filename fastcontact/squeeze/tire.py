@@ -165,6 +165,62 @@ def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
     return model
 
 
+def _check_options(pressure_profile, pressure_model, du_complete, ratios, columns):
+    """Validated options of :func:`tire_footprint`: the profile's peak-to-mean ratio [-],
+    du_complete [m], the ratios [-] as a tuple of floats and the list of wanted columns."""
+    if pressure_model not in ("mean", "peak"):
+        raise ValueError(f"pressure_model = {pressure_model!r} is invalid: must be 'mean' or 'peak'")
+    _, peak = profile_factors(pressure_profile)
+    du_complete = float(check_positive("du_complete", du_complete, "[m]"))
+    ratios = tuple(float(r) for r in np.atleast_1d(as_float_array("ratios", ratios)).ravel())
+    for r in ratios:
+        if not r > 1.0 or not math.isfinite(r):
+            raise ValueError(f"ratios = {ratios!r} is invalid: each must be a finite number > 1")
+    allc = tire_columns(ratios)
+    columns = allc if columns is None else list(columns)
+    unknown = [c for c in columns if c not in allc]
+    if unknown:
+        raise ValueError(f"columns = {unknown!r} is invalid: tire columns are {allc}")
+    return peak, du_complete, ratios, columns
+
+
+def _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out):
+    """The squeeze-out columns into ``out``: the base engine, or the Barus fluid engine of
+    :mod:`fastcontact.squeeze.tire_piezo` if any row has α > 0 (issue 14). Returns the model."""
+    if np.any(b["alpha_pv"] > 0.0):
+        from .tire_piezo import barus_tire_columns
+        return barus_tire_columns(
+            tables, b, p_eval, t_fp, theory, ratios, _ratio_names(ratios), du_complete,
+            b["alpha_pv"], out, lambda tb, bb, pe, tf, o: _squeeze_columns(
+                tb, bb, pe, tf, theory, ratios, du_complete, method, o))
+    return _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out)
+
+
+def _inertia_columns(b, p_eval, u_used, h_rms, out):
+    """``tau_inertia`` τ' = (D²ρ/(64 p_eval))^{1/2} [s] (D = 2R) and ``t_star_inertia``
+    τ' ln(ū(0)/h_rms) [s] (NaN where ū(0) is unknown or <= h_rms) into ``out`` — Sec. 5."""
+    n = p_eval.size
+    tau = np.asarray(inertia_time_constant(2.0 * b["R"], b["rho"], p_eval), float) * np.ones(n)
+    out["tau_inertia"] = tau
+    u0 = u_used if u_used is not None else np.full(n, np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out["t_star_inertia"] = np.where(u0 > h_rms, tau * np.log(u0 / h_rms), np.nan)
+
+
+def _footprint_frame(out, columns, n, model, method):
+    """The result frame of :func:`tire_footprint` (NaN for columns not computed) with units,
+    and the squeeze model's theory and references when one ran."""
+    df = pd.DataFrame({c: out[c] if c in out else np.full(n, np.nan) for c in columns},
+                      copy=False)
+    df.attrs["units"] = {c: TIRE_UNITS.get(c, TIRE_UNITS.get(c.rsplit("_", 1)[0], ""))
+                         for c in columns}
+    if model is not None:
+        a = attrs(model, [], method)
+        a.pop("units")
+        df.attrs.update({k: v for k, v in a.items() if k not in df.attrs})
+    return df
+
+
 def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1000.0,
                    theory=DEFAULT_THEORY, pressure_profile="uniform", pressure_model="mean",
                    u_start=PAPER_TIRE["u_start"], du_complete=1e-6, ratios=(1.1, 1.01, 1.001),
@@ -222,19 +278,8 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
         and ``references``. ``status`` explains every NaN/inf row ("ok", "trapped",
         "out_of_table", "start_below_equilibrium", "overflow").
     """
-    if pressure_model not in ("mean", "peak"):
-        raise ValueError(f"pressure_model = {pressure_model!r} is invalid: must be 'mean' or 'peak'")
-    _, peak = profile_factors(pressure_profile)
-    du_complete = float(check_positive("du_complete", du_complete, "[m]"))
-    ratios = tuple(float(r) for r in np.atleast_1d(as_float_array("ratios", ratios)).ravel())
-    for r in ratios:
-        if not r > 1.0 or not math.isfinite(r):
-            raise ValueError(f"ratios = {ratios!r} is invalid: each must be a finite number > 1")
-    allc = tire_columns(ratios)
-    columns = allc if columns is None else list(columns)
-    unknown = [c for c in columns if c not in allc]
-    if unknown:
-        raise ValueError(f"columns = {unknown!r} is invalid: tire columns are {allc}")
+    peak, du_complete, ratios, columns = _check_options(
+        pressure_profile, pressure_model, du_complete, ratios, columns)
     want = set(columns)
     b = _inputs(p0, E_star, R, eta, footprint_length, speed, rho, u_start, alpha_pv)
     n = b["p0"].size
@@ -247,32 +292,12 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
     if want - {"p_eval", "p_peak", "t_footprint", "tau_inertia"}:
         if method is None:
             method = squeeze_method(n)
-        if np.any(b["alpha_pv"] > 0.0):                    # issue 14: Barus fluid
-            from .tire_piezo import barus_tire_columns
-            model = barus_tire_columns(
-                tables, b, p_eval, t_fp, theory, ratios, _ratio_names(ratios), du_complete,
-                b["alpha_pv"], out, lambda tb, bb, pe, tf, o: _squeeze_columns(
-                    tb, bb, pe, tf, theory, ratios, du_complete, method, o))
-        else:
-            model = _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete,
-                                     method, out)
+        model = _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method,
+                                 out)
         u_used = out["u_start"]
     if want & {"tau_inertia", "t_star_inertia"}:
-        tau = np.asarray(inertia_time_constant(2.0 * b["R"], b["rho"], p_eval), float) * np.ones(n)
-        out["tau_inertia"] = tau
-        u0 = u_used if u_used is not None else np.full(n, np.nan)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            out["t_star_inertia"] = np.where(u0 > tables.h_rms, tau * np.log(u0 / tables.h_rms),
-                                             np.nan)
-    df = pd.DataFrame({c: out[c] if c in out else np.full(n, np.nan) for c in columns},
-                      copy=False)
-    df.attrs["units"] = {c: TIRE_UNITS.get(c, TIRE_UNITS.get(c.rsplit("_", 1)[0], ""))
-                         for c in columns}
-    if model is not None:
-        a = attrs(model, [], method)
-        a.pop("units")
-        df.attrs.update({k: v for k, v in a.items() if k not in df.attrs})
-    return df
+        _inertia_columns(b, p_eval, u_used, tables.h_rms, out)
+    return _footprint_frame(out, columns, n, model, method)
 
 
 def tire_history(tables, *, p0, E_star, R, eta, t, theory=DEFAULT_THEORY,
