@@ -12,9 +12,10 @@ from pathlib import Path
 
 HERE = Path(__file__).parent
 ORDER = ["tables", "squeeze", "seal", "sweep", "run_memory", "fuzz", "extensions",
-         "calibration_integration"]
+         "calibration_integration", "layout"]
 #: fragments whose script name differs from bench_<name>.py
-SCRIPT = {"run_memory": "bench_run_memory.py"}
+SCRIPT = {"run_memory": "bench_run_memory.py",
+          "layout": "bench_tables.py --speed, bench_squeeze.py, bench_seal.py"}
 HEADER = """# fastcontact benchmark results
 
 Numbers are produced by the scripts in `bench/` (each section names its script). Machines are

@@ -19,7 +19,7 @@ Reference: B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1
 """
 from __future__ import annotations
 
-import importlib
+from ._core.lazy import lazy_getattr
 
 __version__ = "0.2.0"
 
@@ -45,13 +45,7 @@ _SUBPACKAGES = ("contact", "flow", "kernels", "seal", "squeeze", "studies", "sur
 __all__ = sorted(_LAZY) + ["__version__"]
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        mod = importlib.import_module(f".{_LAZY[name]}", __name__)
-        return getattr(mod, name)
-    if name in _SUBPACKAGES:
-        return importlib.import_module(f".{name}", __name__)
-    raise AttributeError(f"module 'fastcontact' has no attribute {name!r}")
+__getattr__ = lazy_getattr(__name__, _LAZY, _SUBPACKAGES)
 
 
 def __dir__():

@@ -186,23 +186,27 @@ def build_primitive(tab, sc, tn, n_ver, max_depth):
     P[n, P_D1], P[n, P_D2] = _node_d(tab, sc, tn[tn.size - 1])
     for k in range(n):
         P[k, P_IH] = 1.0 / (P[k + 1, P_T] - P[k, P_T])
-    acc = 0.0
-    comp = 0.0
-    for k in range(n):                       # compensated (Kahan) sums
-        y = P[k, P_CELL] - comp
-        s = acc + y
-        comp = (s - acc) - y
-        acc = s
-        P[k + 1, P_PRE] = acc
-    acc = 0.0
-    comp = 0.0
-    for k in range(n - 1, -1, -1):
-        y = P[k, P_CELL] - comp
-        s = acc + y
-        comp = (s - acc) - y
-        acc = s
-        P[k, P_SUF] = acc
+    _kahan_sums(P, n, False)  # prefix sums of the cells into P_PRE (row k + 1)
+    _kahan_sums(P, n, True)   # suffix sums into P_SUF (row k)
     return P
+
+
+@njit(cache=True)
+def _kahan_sums(P, n, suffix):
+    """Compensated (Kahan) running sums of P[:n, P_CELL]: prefix sums into P[k + 1, P_PRE]
+    (``suffix`` False) or suffix sums into P[k, P_SUF] (True)."""
+    acc = 0.0
+    comp = 0.0
+    for j in range(n):
+        k = n - 1 - j if suffix else j
+        y = P[k, P_CELL] - comp
+        s = acc + y
+        comp = (s - acc) - y
+        acc = s
+        if suffix:
+            P[k, P_SUF] = acc
+        else:
+            P[k + 1, P_PRE] = acc
 
 
 @njit(cache=True)

@@ -13,27 +13,13 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 from .._core.io import atomic_path, write_bytes_atomic
+from .._core.jsonable import json_default
 from .._core.vocab import METADATA_KEY
 from .kinds import column_units
 from .schema import input_units
 
 __all__ = ["ParquetStream", "write_parquet_atomic", "write_json_atomic", "json_default",
            "column_summary"]
-
-
-def json_default(o):
-    """JSON encoder for numpy scalars and arrays, paths, tuples and records with to_dict()."""
-    if isinstance(o, (np.floating, np.integer, np.bool_)):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, Path):
-        return str(o)
-    if isinstance(o, tuple):
-        return list(o)
-    if hasattr(o, "to_dict"):
-        return o.to_dict()
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
 
 _json_default = json_default

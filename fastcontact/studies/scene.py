@@ -14,13 +14,13 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import importlib
 import math
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from .._core.lazy import lazy_getattr
 from .._core.vocab import THEORIES
 from ..contact.elasticity import effective_modulus
 from ..surface.psd import SelfAffinePSD
@@ -232,11 +232,8 @@ _LEGACY_HOMES = {
 _LEGACY = {name: mod for mod, names in _LEGACY_HOMES.items() for name in names}
 
 
-def __getattr__(name):
-    """The former scene API, resolved from its new module on first use."""
-    if name in _LEGACY:
-        return getattr(importlib.import_module(_LEGACY[name]), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+#: the former scene API, resolved from its new module on first use
+__getattr__ = lazy_getattr(__name__, _LEGACY)
 
 
 def __dir__():

@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 
+from .._core.jsonable import json_plain
 from .._core.validate import check_positive, check_range
 from .._core.vocab import THEORIES
 from ..contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
@@ -65,13 +66,6 @@ def default_grid(surface: PSD, gamma=1.0, points_per_decade=DEFAULT_POINTS_PER_D
 CALIBRATED = {"gamma": 1.0, "alpha_cj": 1.0, "a_perc": 0.5, "emt_threshold": 0.5}
 
 
-def _plain(obj):
-    """JSON fallback for a calibration's provenance: numpy scalars/arrays, else str."""
-    if hasattr(obj, "tolist"):
-        return obj.tolist()
-    return str(obj)
-
-
 def _calibration_block(calibration, given):
     """(constants dict, provenance block) of a calibration; ValueError on a conflict.
 
@@ -91,7 +85,7 @@ def _calibration_block(calibration, given):
                              f"sets {k} = {const[k]!r} (pass one or the other)")
     block = dict(const, fitted=list(getattr(calibration, "fitted", ()) or ()),
                  provenance=getattr(calibration, "provenance", {}) or {})
-    return const, json.loads(json.dumps(block, default=_plain, sort_keys=True))
+    return const, json.loads(json.dumps(block, default=json_plain, sort_keys=True))
 
 
 def _theory_options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist, emt_threshold=0.5):

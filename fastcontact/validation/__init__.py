@@ -13,7 +13,7 @@ reference table do not. Submodules are imported lazily.
 """
 from __future__ import annotations
 
-import importlib
+from .._core.lazy import lazy_getattr
 
 #: submodule -> the names it gives this package (imported on first use)
 _SUBMODULE_NAMES = {
@@ -28,11 +28,7 @@ _LAZY = {name: mod for mod, names in _SUBMODULE_NAMES.items() for name in names}
 __all__ = sorted(_LAZY)
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        mod = importlib.import_module(f".{_LAZY[name]}", __name__)
-        return getattr(mod, name)
-    raise AttributeError(f"module 'fastcontact.validation' has no attribute {name!r}")
+__getattr__ = lazy_getattr(__name__, _LAZY)
 
 
 def __dir__():

@@ -30,6 +30,9 @@ import math
 
 import numpy as np
 
+from .._core.io import write_bytes_atomic
+from .._core.jsonable import json_plain
+
 __all__ = ["Calibration", "calibrate", "residuals", "PARAMETERS", "BOUNDS", "DEFAULTS"]
 
 PARAMETERS = ("gamma", "alpha_cj", "a_perc", "emt_threshold")
@@ -106,10 +109,8 @@ class Calibration:
 
     def to_json(self, path=None):
         """JSON text (written atomically to ``path`` if given)."""
-        text = json.dumps(self.to_dict(), indent=2, default=_plain, allow_nan=True)
-        if path is not None:
-            _atomic_write(path, text)
-        return text
+        return _emit(json.dumps(self.to_dict(), indent=2, default=json_plain, allow_nan=True),
+                     path)
 
     @classmethod
     def from_json(cls, source):
@@ -124,16 +125,13 @@ class Calibration:
         for name in PARAMETERS:
             lines.append(f"{name} = {float(getattr(self, name))!r}")
         lines.append(f"fitted = {json.dumps(list(self.fitted))}")
-        lines.append(f"provenance_json = {json.dumps(json.dumps(self.provenance, default=_plain))}")
+        lines.append(f"provenance_json = {json.dumps(json.dumps(self.provenance, default=json_plain))}")
         for tab in ("residuals_before", "residuals_after"):
             lines += ["", f"[{tab}]"]
             for k, v in getattr(self, tab).items():
                 v = float(v)
                 lines.append(f"{k} = {'nan' if math.isnan(v) else repr(v)}")
-        text = "\n".join(lines) + "\n"
-        if path is not None:
-            _atomic_write(path, text)
-        return text
+        return _emit("\n".join(lines) + "\n", path)
 
     @classmethod
     def from_toml(cls, source):
@@ -148,14 +146,6 @@ class Calibration:
         return cls.from_dict(d)
 
 
-def _plain(o):
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    return str(o)
-
-
 def _read_text(source):
     import os
 
@@ -166,19 +156,11 @@ def _read_text(source):
     return s
 
 
-def _atomic_write(path, text):
-    import os
-    import tempfile
-
-    path = os.fspath(path)
-    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(path)), suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+def _emit(text, path):
+    """``text``, written atomically (UTF-8) to ``path`` first if one is given."""
+    if path is not None:
+        write_bytes_atomic(path, text.encode("utf-8"))
+    return text
 
 
 def _clip_log(th, ref):
@@ -283,13 +265,9 @@ def calibrate(psd, E_star, reference, *, fit=None, initial=None,
     """
     from scipy.optimize import least_squares
 
-    from .compare import psd_from_reference
+    from .compare import reference_psd_and_modulus
 
-    if psd is None:
-        psd = psd_from_reference(reference)
-    E_star = float(E_star)
-    if not (E_star > 0 and math.isfinite(E_star)):
-        raise ValueError(f"E_star = {E_star!r} is invalid: must be finite and > 0 [Pa]")
+    psd, E_star = reference_psd_and_modulus(reference, psd, E_star)
     if "p0" not in reference or len(reference) == 0:
         raise ValueError("reference is invalid: it needs a non-empty 'p0' column [Pa]")
     start = dict(DEFAULTS) | dict(initial or {})

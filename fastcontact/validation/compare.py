@@ -23,6 +23,9 @@ import math
 
 import numpy as np
 
+from .._core.io import atomic_path
+from .._core.jsonable import json_default
+
 __all__ = ["compare_theories", "squeeze_time_ratio", "write_reference", "read_reference",
            "theory_sigma", "theory_flow_stop", "DEFAULT_VARIANTS"]
 
@@ -83,31 +86,13 @@ def write_reference(df, path):
     """Write a reference DataFrame with its ``attrs`` (JSON in the Parquet metadata) [atomic]."""
     import pyarrow as pa
     import pyarrow.parquet as pq
-    import os
-    import tempfile
 
     table = pa.Table.from_pandas(df, preserve_index=False)
     meta = dict(table.schema.metadata or {})
-    meta[b"fastcontact.reference"] = json.dumps(df.attrs, default=_json_default).encode()
+    meta[b"fastcontact.reference"] = json.dumps(df.attrs, default=json_default).encode()
     table = table.replace_schema_metadata(meta)
-    path = os.fspath(path)
-    d = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")
-    os.close(fd)
-    try:
+    with atomic_path(path) as tmp:
         pq.write_table(table, tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-
-
-def _json_default(o):
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError(f"cannot store {type(o).__name__} in reference metadata")
 
 
 def read_reference(path):
@@ -128,6 +113,17 @@ def read_reference(path):
     raw = (table.schema.metadata or {}).get(b"fastcontact.reference")
     df.attrs = json.loads(raw) if raw else {}
     return df
+
+
+def reference_psd_and_modulus(reference, psd, E_star):
+    """(psd, E* [Pa]) for a comparison or calibration: the reference's own PSD unless one is
+    given; ValueError unless E* is finite and > 0."""
+    if psd is None:
+        psd = psd_from_reference(reference)
+    E_star = float(E_star)
+    if not (E_star > 0 and math.isfinite(E_star)):
+        raise ValueError(f"E_star = {E_star!r} is invalid: must be finite and > 0 [Pa]")
+    return psd, E_star
 
 
 def psd_from_reference(reference):
@@ -305,11 +301,7 @@ def compare_theories(psd, E_star, reference, *, variants=None, calibration=None,
 
     from .. import contact
 
-    if psd is None:
-        psd = psd_from_reference(reference)
-    E_star = float(E_star)
-    if not (E_star > 0 and math.isfinite(E_star)):
-        raise ValueError(f"E_star = {E_star!r} is invalid: must be finite and > 0 [Pa]")
+    psd, E_star = reference_psd_and_modulus(reference, psd, E_star)
     if "p0" not in reference:
         raise ValueError("reference is invalid: it needs a 'p0' column [Pa]")
     variants = list(DEFAULT_VARIANTS if variants is None else variants)
