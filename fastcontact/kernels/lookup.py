@@ -92,12 +92,31 @@ def k_lnp_of_lnu(tab, lnu_q):
                             1.0 / a[i + 1], -d2[i] / a[i] ** 3, -d2[i + 1] / a[i + 1] ** 3)
 
 
+@njit(cache=True, inline="always")
+def sigma_interval_resolved(tab, i):
+    """Whether ln σ̄'s quintic on the open interval [lnp[i], lnp[i+1]] is trusted: both end
+    slopes times the width have the sign of the interval's Δ ln σ̄ and at most 3 times its size
+    (Fritsch–Carlson); else the interval is unresolved and ln σ̄ is linear across it."""
+    h = tab.lnp[i + 1] - tab.lnp[i]
+    dy = tab.lnsig[i + 1] - tab.lnsig[i]
+    s0, s1 = tab.dlnsig[i] * h, tab.dlnsig[i + 1] * h
+    return s0 * dy >= 0.0 and s1 * dy >= 0.0 and abs(s0) <= 3.0 * abs(dy) \
+        and abs(s1) <= 3.0 * abs(dy)
+
+
 @njit(cache=True)
 def k_sigma_of_lnp(tab, lnp_q):
     """σ̄ = 12ησ_eff/h_rms³ at ln p̄; exactly 0 at and beyond percolation; NaN outside.
 
     Quintic Hermite of ln σ̄ between open nodes; between the last open node and the exact
-    percolation pressure σ̄^(1/3) falls linearly in ln p̄ to 0 (σ̄ < 1e-30 there).
+    percolation pressure σ̄^(1/3) falls linearly in ln p̄ to 0 (σ̄ < 1e-30 there). ln σ̄ is
+    monotone in ln p̄: where the quintic could leave the range of its interval's node values
+    (an interval the build could not resolve, next to percolation, where σ̄ drops by tens of
+    decades, e.g. 1e-23 → 1e-90, below the tables' σ̄ floor; a resolved interval never does),
+    ln σ̄ is interpolated linearly between the nodes instead of overshooting (σ̄ up to inf).
+    The test is on the interval's data (Fritsch–Carlson: both end slopes h·(d ln σ̄/d ln p̄)
+    of the sign of Δ ln σ̄ and at most 3|Δ ln σ̄|; resolved intervals have ratios 0.94–1.06),
+    so an interval is interpolated one way throughout.
     """
     lnp, lnsig, dlnsig, lnp_perc, n_open = tab.lnp, tab.lnsig, tab.dlnsig, tab.lnp_perc, tab.n_open
     i = locate_asc(lnp_q, lnp, tab.bp_lo, tab.bp_dz, tab.bp_idx)
@@ -107,8 +126,11 @@ def k_sigma_of_lnp(tab, lnp_q):
         return 0.0
     if i + 1 < n_open:
         d2 = tab.d2lnsig
-        return math.exp(quintic_interval(lnp_q, lnp[i], lnp[i + 1], lnsig[i], lnsig[i + 1],
-                                         dlnsig[i], dlnsig[i + 1], d2[i], d2[i + 1]))
+        y0, y1 = lnsig[i], lnsig[i + 1]
+        if sigma_interval_resolved(tab, i):
+            return math.exp(quintic_interval(lnp_q, lnp[i], lnp[i + 1], y0, y1, dlnsig[i],
+                                             dlnsig[i + 1], d2[i], d2[i + 1]))
+        return math.exp(y0 + (y1 - y0) / (lnp[i + 1] - lnp[i]) * (lnp_q - lnp[i]))  # linear
     j = n_open - 1
     if j < 0 or lnp_perc == math.inf:
         return 0.0

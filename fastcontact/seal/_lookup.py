@@ -18,6 +18,7 @@ from numba import njit, prange
 
 from ..kernels.hermite import quintic_interval, quintic_unit
 from ..kernels.locate import locate_asc
+from ..kernels.lookup import sigma_interval_resolved
 from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
 
 __all__ = ["sig_d", "table_sig_d", "sigma_of_c", "ubar_of_c", "retabulate", "verify_cells",
@@ -44,6 +45,9 @@ def table_sig_d(tab, t):
         return 0.0, -math.inf
     if i + 1 < tab.n_open:
         h = lnp[i + 1] - lnp[i]
+        if not sigma_interval_resolved(tab, i):  # as k_sigma_of_lnp: linear in ln σ̄
+            dy = (tab.lnsig[i + 1] - tab.lnsig[i]) / h
+            return math.exp(tab.lnsig[i] + dy * (t - lnp[i])), dy
         y, dy = quintic_unit((t - lnp[i]) / h, h, tab.lnsig[i], tab.dlnsig[i], tab.d2lnsig[i],
                              tab.lnsig[i + 1], tab.dlnsig[i + 1], tab.d2lnsig[i + 1])
         return math.exp(y), dy
