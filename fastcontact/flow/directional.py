@@ -46,7 +46,7 @@ def _nodes(psd, pbar, gamma, n_panels):
     at low pressure A(ζ) falls within ζ - 1 ~ (p/E*)² < 1e-16, where ζ is not representable.
     """
     A1 = erf(pbar / (2.0 * math.sqrt(0.25 * math.pi * psd.cum3[-1])))
-    x, w = np.polynomial.legendre.leggauss(GL_ORDER)
+    x, w = gauss_legendre(GL_ORDER)
     edges = np.linspace(0.0, 1.0, n_panels + 1)
     half = 0.5 * np.diff(edges)
     t = (0.5 * (edges[:-1] + edges[1:])[:, None] + half[:, None] * x[None, :]).ravel()

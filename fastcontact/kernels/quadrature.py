@@ -9,52 +9,15 @@
 from __future__ import annotations
 
 import math
-from functools import lru_cache
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from .powerlaw import seg_moment_np
+from .rules import GL_ORDER, QuadRule, gauss_hermite, gauss_legendre
 
 __all__ = ["QuadRule", "gauss_legendre", "gauss_kronrod15", "gauss_hermite", "seg_moment",
            "seg_moment_np", "GL_ORDER"]
-
-#: default Gauss–Legendre order of the contact-mechanics panels
-GL_ORDER = 10
-
-
-class QuadRule(NamedTuple):
-    """Nodes ``x`` on [-1, 1] and weights ``w`` of a quadrature rule (contiguous float64)."""
-
-    x: np.ndarray
-    w: np.ndarray
-
-
-@lru_cache(maxsize=None)
-def gauss_legendre(n: int = GL_ORDER) -> QuadRule:
-    """Gauss–Legendre nodes and weights of order ``n`` on [-1, 1] (cached; do not mutate).
-
-    Parameters
-    ----------
-    n : int
-        Number of nodes, >= 1 (default 10).
-
-    Returns
-    -------
-    QuadRule
-        ``(x, w)``, contiguous float64 arrays; a 2-tuple, so ``x, w = gauss_legendre(n)``.
-    """
-    x, w = np.polynomial.legendre.leggauss(int(n))
-    return QuadRule(np.ascontiguousarray(x), np.ascontiguousarray(w))
-
-
-@lru_cache(maxsize=None)
-def gauss_hermite(n: int) -> QuadRule:
-    """Gauss–Hermite nodes and weights (weight e^{-x²} on the real line), cached."""
-    x, w = np.polynomial.hermite.hermgauss(int(n))
-    return QuadRule(np.ascontiguousarray(x), np.ascontiguousarray(w))
-
 
 _XGK = np.array([-0.991455371120812639206854697526329, -0.949107912342758524526189684047851,
                  -0.864864423359769072789712788640926, -0.741531185599394439863864773280788,

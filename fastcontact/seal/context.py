@@ -14,6 +14,7 @@ import numpy as np
 
 from .._core.cache import PerObjectCache
 from ..flow.conductivity import check_theory
+from ..kernels.quadrature import gauss_legendre
 from ..tables.build import SIGMA_FLOOR
 from . import _sigma
 
@@ -187,7 +188,7 @@ class SealContext:
         nret = int(math.floor((t_top - t_lo) / RETAB_H)) + 1
         lns, dlns = _sigma.retabulate(self.tab, t_lo, RETAB_H, nret)
         sh = PRIM_H if prim_h is None else float(prim_h)
-        glx, glw = np.polynomial.legendre.leggauss(PRIM_GL if prim_gl is None else int(prim_gl))
+        glx, glw = gauss_legendre(PRIM_GL if prim_gl is None else int(prim_gl))
         P0 = np.zeros((2, _sigma.P_COLS))
         rec = SealRecord(t_lo, t_hi, t_perc, float(f[0]), float(b1), u_lo, c_u, t_lo, RETAB_H,
                          lns, dlns, np.ones(nret - 1, dtype=np.bool_), t_lo, sh, t_top,
@@ -324,7 +325,7 @@ def _gl_matrices(n):
     projection matrix of an n-point panel (cached)."""
     if n not in _GL_CACHE:
         Lg = np.polynomial.legendre
-        z, w = Lg.leggauss(n)
+        z, w = gauss_legendre(n)
         V = Lg.legvander(z, n - 1)
         Vi = np.linalg.inv(V)
         At = np.empty((n, n))

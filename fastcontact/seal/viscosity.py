@@ -38,6 +38,7 @@ import pandas as pd
 
 from .._core.validate import check_positive
 from ..flow.piezoviscosity import ROELANDS_ETA_INF, check_law, roelands_parameters
+from ..kernels.quadrature import gauss_legendre
 from ._piezo_kernels import TAIL_CUT, _hertz_kernel, _hertz_kernel_r, _uniform_kernel
 
 __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
@@ -199,7 +200,7 @@ def _uniform_rows(tab, sc, v, law, quad_order, quad_width):
     kq = np.zeros(E.size)
     run = ~lift & ~perc & ~out_t & (v["dp"] > 0)
     if np.any(run):
-        x, w = np.polynomial.legendre.leggauss(int(quad_order))
+        x, w = gauss_legendre(int(quad_order))
         out = np.empty(int(run.sum()))
         A, Z, pr = law if law is not None else (v["alpha_pv"], np.zeros(E.size), 0.0)
         sub = [np.ascontiguousarray(a[run], dtype=np.float64) for a in (p0v, Lv, pa, pb, E, A, Z)]

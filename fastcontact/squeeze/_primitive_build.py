@@ -15,6 +15,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, prange
 
+from ..kernels.quadrature import gauss_legendre
 from . import _kernels as qk
 from ._primitive_eval import Primitive, _index_map, row_value, stencil, t_of_z
 
@@ -306,7 +307,7 @@ def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, order=NODE_ORDER, check=True):
     nx = xn.size
     C = np.empty((nx, nz, 3))
     lnv, lnS, zs, sx, lk = (np.empty(nx) for _ in range(5))
-    glx, glw = np.polynomial.legendre.leggauss(order)
+    glx, glw = gauss_legendre(order)
     _build_kernel(pf, mp, xn, float(z_lo), float(dz), glx, glw, C, lnv, lnS, zs, sx, lk)
     pr = Primitive(xn, *_index_map(xn), float(z_lo), float(dz), nz, C, lnv, lnS, zs, sx, lk, float(mp.v_ext), float(mp.c), float(mp.d))
     info = {"nx": int(nx), "nz": int(nz), "dxi": float(dxi), "build_seconds":
@@ -325,7 +326,7 @@ def measure_error(model, pr, pf, n_x=64, order=NODE_ORDER):
     zc = pr.z0 + (np.arange(pr.nz - 1) + 0.5) * pr.dz
     X, Z = np.meshgrid(xm, zc, indexing="ij")
     err = np.empty(X.size)
-    glx, glw = np.polynomial.legendre.leggauss(order)
+    glx, glw = gauss_legendre(order)
     _check_kernel(pf, model.mp, pr, np.ascontiguousarray(X.ravel()),
                   np.ascontiguousarray(Z.ravel()), glx, glw, err)
     return {"max_rel_err_T": float(np.max(err)), "checked_points": int(err.size)}

@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
+from ..kernels.quadrature import gauss_legendre
+
 _GL_ORDER = 20
-_GLX, _GLW = (np.ascontiguousarray(a) for a in np.polynomial.legendre.leggauss(_GL_ORDER))
+_GLX, _GLW = gauss_legendre(_GL_ORDER)
 #: above α·v = 40 the factor 1 - e^{-αv} is 1 to 4e-18: closed-form tail
 _X_TAIL = 40.0
 #: v below ū∞·e^{-40} (4e-18 relative) leaves ū = ū∞ in double precision

@@ -19,6 +19,7 @@ from ._fastpath import fast_kernel, history_kernel, one_case_primitive, quad_ker
 from .model import DEFAULT_P_START, squeeze_model
 from .primitive import fast_limit
 from .reduced import flat_separation
+from ..kernels.quadrature import gauss_legendre
 
 __all__ = ["squeeze_out", "squeeze_history", "columns", "register_extension", "QUAD_ORDER",
            "QUAD_WIDTH", "STATUS_NAMES"]
@@ -98,7 +99,7 @@ def _check_method(method, quad_order, quad_width, sigma_trap):
     if sigma_trap is not None:
         sigma_trap = float(check_positive("sigma_trap", sigma_trap,
                                           "[-] (reduced conductivity floor)"))
-    glx, glw = np.polynomial.legendre.leggauss(int(qo))
+    glx, glw = gauss_legendre(int(qo))
     return qk.Quad(glx, glw, qw), sigma_trap
 
 

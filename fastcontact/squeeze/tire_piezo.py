@@ -26,6 +26,7 @@ import numpy as np
 import pandas as pd
 from numba import njit, prange
 
+from ..kernels.quadrature import gauss_legendre
 from .api import STATUS_NAMES
 from .viscosity import (_lnv_of_lnp, _rate_factor, _scalars, _segment, _start, _state,
                         _target_times)
@@ -146,7 +147,7 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
     st = np.empty(m, dtype=np.int8)
     if m:
         us_in = b["u_start"][sel] if "u_start" in b else np.full(m, np.nan)
-        x, w = np.polynomial.legendre.leggauss(QUAD_ORDER)
+        x, w = gauss_legendre(QUAD_ORDER)
         args = [np.ascontiguousarray(a, dtype=np.float64) for a in
                 (p_eval[sel], b["E_star"][sel], b["R"][sel], b["eta"][sel], alpha[sel], us_in,
                  t_fp[sel])]

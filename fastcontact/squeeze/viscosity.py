@@ -33,6 +33,7 @@ from .._core.validate import check_positive
 from .._core.vocab import DEFAULT_THEORY, column_name
 from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
 from .api import register_extension, squeeze_out
+from ..kernels.quadrature import gauss_legendre
 
 __all__ = [
     "DEFAULT_P_START",
@@ -346,7 +347,7 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     T = np.empty((vr.size + dv.size, n))
     uinf, ustart, tau0, gs = (np.empty(n) for _ in range(4))
     status = np.empty(n, dtype=np.int8)
-    x, w = np.polynomial.legendre.leggauss(qo)
+    x, w = gauss_legendre(qo)
     _piezo_kernel(tables.kernel_data(theory), sc, *flat, h, vr, dv, x, w, width, T, uinf,
                   ustart, tau0, gs, status)
     if u_start is not None:

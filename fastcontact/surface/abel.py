@@ -15,10 +15,11 @@ import numpy as np
 from scipy.special import betainc, beta as beta_fn, gammaln
 
 from .._core.validate import as_float_array
+from ..kernels.rules import gauss_legendre
 
 __all__ = ["abel_forward", "abel_invert", "abel_fit", "ABEL_SLOPE_PRIOR"]
 
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
+_GL_X, _GL_W = gauss_legendre(8)
 #: prior std of the change of log-log slope between neighbouring C1D nodes (line scans)
 ABEL_SLOPE_PRIOR = 1.0
 

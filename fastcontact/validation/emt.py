@@ -69,6 +69,8 @@ def _zeta_at_area(psd, pbar, area):
 
 
 def _nodes(n_panels):
+    # numpy's rule directly, not kernels.quadrature: this reference shares no code with the
+    # engine it checks
     x, w = np.polynomial.legendre.leggauss(ORDER)
     edges = np.linspace(0.0, 1.0, n_panels + 1)
     half = 0.5 * np.diff(edges)
