@@ -33,6 +33,7 @@ import threading
 from pathlib import Path
 
 from .cli_parser import CLIError, build_parser
+from ._core.vocab import CONVENTIONS
 from .studies.progress import Progress
 
 __all__ = ["main", "build_parser"]
@@ -123,8 +124,8 @@ def _cmd_tables_build(a, out, err):
             raise CLIError("fastcontact tables build: give either --psd FILE --convention X or "
                            "--h-rms --hurst --q0 --q1 [--q-roll], not both")
         if a.convention is None:
-            raise CLIError("fastcontact tables build: --psd needs --convention persson|"
-                           "surface_topography")
+            raise CLIError("fastcontact tables build: --psd needs --convention "
+                           + "|".join(CONVENTIONS))
         from .surface.topography import read_psd
         psd = read_psd(a.psd, a.convention)
     else:

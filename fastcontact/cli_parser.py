@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import argparse
 
+from ._core.vocab import CONVENTIONS, THEORIES
+
 __all__ = ["build_parser", "CLIError"]
 
 
@@ -69,9 +71,9 @@ def _add_tables_parser(sub):
     tb.add_argument("--q1", type=_quantity("wavevector"), help="largest wavevector [1/m]")
     tb.add_argument("--q-roll", type=_quantity("wavevector"), help="roll-off wavevector [1/m]")
     tb.add_argument("--psd", help="PSD file (.csv or .parquet with columns q, C)")
-    tb.add_argument("--convention", choices=("persson", "surface_topography"),
+    tb.add_argument("--convention", choices=tuple(CONVENTIONS),
                     help="normalisation of the PSD file's C")
-    tb.add_argument("--theories", nargs="+", default=["average", "critical_junction", "emt"],
+    tb.add_argument("--theories", nargs="+", default=list(THEORIES),
                     help="flow theories to tabulate (space or comma separated)")
     tb.add_argument("--gamma", type=float, default=1.0, help="Yang-Persson factor (1 = paper)")
     tb.add_argument("--a-perc", type=float, default=0.5, help="percolation threshold A/A0")
@@ -133,7 +135,7 @@ def build_parser():
     w.add_argument("--scene", required=True, help="scene file or shipped example name")
     w.add_argument("--scheduler", help="address of an existing Dask scheduler")
     w.add_argument("--workers", type=int, help="local worker processes (default: cores)")
-    w.add_argument("--convention", choices=("persson", "surface_topography"),
+    w.add_argument("--convention", choices=tuple(CONVENTIONS),
                    help="C convention of database files that record none")
     w.add_argument("--cache-dir", help="keep/reuse the tables there (default: not kept)")
     w.add_argument("--no-progress", action="store_true", help="no progress line")
@@ -149,11 +151,11 @@ def build_parser():
     dg.add_argument("--seed", type=int, required=True, help="random seed")
     dg.add_argument("--n-q", type=int, default=None,
                     help="samples per spectrum (default: the roaddb module's N_Q)")
-    dg.add_argument("--convention", choices=("persson", "surface_topography"), default="persson",
+    dg.add_argument("--convention", choices=tuple(CONVENTIONS), default="persson",
                     help="C convention written to the files")
     di = dsub.add_parser("info", help="summarise a road database")
     di.add_argument("path", help="road database (Parquet dataset or folder of PSD files)")
-    di.add_argument("--convention", choices=("persson", "surface_topography"),
+    di.add_argument("--convention", choices=tuple(CONVENTIONS),
                     help="C convention of files that record none")
     from .validation.cli import add_bem_commands  # `fastcontact bem` (issue 13)
     add_bem_commands(sub)

@@ -15,6 +15,8 @@ from __future__ import annotations
 import argparse
 import math
 
+from .._core.vocab import CONVENTIONS
+
 __all__ = ["add_bem_commands", "EXIT_MISSING_EXTRA"]
 
 EXIT_MISSING_EXTRA = 2
@@ -52,7 +54,7 @@ def add_bem_commands(subparsers):
     src = r.add_mutually_exclusive_group(required=True)
     src.add_argument("--psd", help="spectrum file (CSV/Parquet, read_psd)")
     src.add_argument("--hurst", type=float, help="self-affine surface: Hurst exponent H")
-    r.add_argument("--convention", choices=("persson", "surface_topography"),
+    r.add_argument("--convention", choices=tuple(CONVENTIONS),
                    help="C convention of a --psd file that records none")
     r.add_argument("--h-rms", type=float, default=1e-6, help="self-affine h_rms [m]")
     r.add_argument("--q0", type=float, default=None, help="self-affine q0 [1/m] (default 2π/1 mm)")

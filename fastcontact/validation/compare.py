@@ -25,6 +25,7 @@ import numpy as np
 
 from .._core.io import atomic_path
 from .._core.jsonable import json_default
+from .._core.vocab import THEORIES
 
 __all__ = ["compare_theories", "squeeze_time_ratio", "write_reference", "read_reference",
            "theory_sigma", "theory_flow_stop", "DEFAULT_VARIANTS"]
@@ -306,7 +307,7 @@ def compare_theories(psd, E_star, reference, *, variants=None, calibration=None,
         raise ValueError("reference is invalid: it needs a 'p0' column [Pa]")
     variants = list(DEFAULT_VARIANTS if variants is None else variants)
     if calibration is not None:
-        for th in ("average", "critical_junction", "emt"):
+        for th in THEORIES:
             variants.append((f"{th}+cal", th, calibration.options(th)))
     eta = float(reference.attrs.get("eta", 1e-3))
     p = reference["p0"].to_numpy(float)
