@@ -297,14 +297,14 @@ def _drop_theories(tables, keep):
 
 
 def _tables_with(tables, keep, data, perc_emt, options, extra_info):
-    from ..tables import Tables
-
+    """A new tables object of the same class as ``tables`` (the flow layer does not import
+    the tables layer above it) holding ``data`` for the theories ``keep``."""
     info = dict(tables.info)
     perc = {k: v for k, v in dict(info.get("percolation_p_over_E", {})).items() if k in keep}
     perc["emt"] = perc_emt
     info["percolation_p_over_E"] = perc
     info.update(extra_info)
-    return Tables(tables.surface, keep, options, tables.grid, tables.zeta_grid, data, info)
+    return type(tables)(tables.surface, keep, options, tables.grid, tables.zeta_grid, data, info)
 
 
 _VIEWS = PerObjectCache()

@@ -11,7 +11,7 @@ Modules: :mod:`.api` (seal_leak, columns), :mod:`.profile`, :mod:`.elastic`, :mo
 (the flat kernel records, built once per tables × theory), private kernels ``_sigma``
 (σ̄ and its primitive), ``_mesh`` and ``_panels`` (the soft-seal solver). Nothing compiles at
 import. References: B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010),
-doi:10.1140/epje/i2010-10621-2.
+arXiv:1004.1037.
 """
 from __future__ import annotations
 

@@ -42,8 +42,8 @@ UNITS = {"Q": "m^3/s", "p0": "Pa", "dp": "Pa", "p_a": "Pa", "p_b": "Pa", "L": "m
          "lift_off": "", "percolated": "", "converged": "", "status": ""}
 
 REFERENCES = (
-    "B. Lorenz and B.N.J. Persson, Fluid squeeze-out between solids with rough surfaces, "
-    "Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10621-2",
+    "B. Lorenz and B.N.J. Persson, Time-dependent fluid squeeze-out between solids with rough "
+    "surfaces, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037",
     "B. Lorenz and B.N.J. Persson, Leak rate of seals: effective-medium theory and comparison "
     "with experiment, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019",
 )
@@ -248,13 +248,11 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
     alpha_pv : float or array_like, default 0.0
         Barus coefficient α [1/Pa], η = η0 exp(α(p_f − p_b)); 0 leaves the result unchanged.
     viscosity : {"barus", "roelands"}, default "barus"
-        Pressure–viscosity law. α_pv ≠ 0 or "roelands" dispatch to
-        :func:`fastcontact.seal.viscosity.seal_leak_piezo` ("uniform", "hertz"), which also
-        takes ``roelands_z`` [-], ``roelands_p_r`` [Pa] and ``roelands_eta_inf`` [Pa·s].
+        Pressure–viscosity law; α_pv ≠ 0 or "roelands": :func:`.viscosity.seal_leak_piezo`
+        ("uniform", "hertz"; ``roelands_z`` [-], ``roelands_p_r`` [Pa], ``roelands_eta_inf``).
     direction : {None, "x", "y"}, default None
-        Flow direction on tables built with ``precompute(..., anisotropy=γ_T)``: "x" along
-        the grooves, "y" across (σ_xx, σ_yy of the anisotropic medium, theory "emt"; "average"
-        has no direction, "critical_junction" raises); isotropic tables: the result of None.
+        On tables of ``precompute(..., anisotropy=γ_T)``: flow along ("x") or across ("y") the
+        grooves (σ_xx, σ_yy; "emt"; "average" has none, "critical_junction" raises); else None.
 
     Returns
     -------
@@ -269,9 +267,9 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
 
     References
     ----------
-    B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10621-2
+    B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037
     """
-    if direction is not None:                  # issue 14: anisotropic roughness (σ_xx, σ_yy)
+    if direction is not None:                  # anisotropic roughness (σ_xx, σ_yy)
         tables = _directional(tables, direction, theory)
     if viscosity != "barus" or np.any(np.asarray(alpha_pv, dtype=np.float64) != 0.0):
         return seal_leak_piezo(tables, p0=p0, dp=dp, L=L, L_y=L_y, E_star=E_star, eta=eta,

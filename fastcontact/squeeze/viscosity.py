@@ -19,7 +19,7 @@ quasi-static rigid-block model fails there (elastohydrodynamic deformation or in
 over) and such rows are flagged ``piezo_limit`` with NaN times — never a silent number.
 
 References: C. Barus, Am. J. Sci. 45, 87 (1893), doi:10.2475/ajs.s3-45.266.87;
-B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), doi:10.1140/epje/i2010-10628-1.
+B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037.
 """
 from __future__ import annotations
 
@@ -396,7 +396,7 @@ def _piezo_frame(flat, ratios, du, T, uinf, ustart, tau0, gs, status, theory):
                      "model": "dū/dt = -(8σ0/R²)(p0-p_cont) g(α(p0-p_cont)), "
                               "g = Φ⁻¹(a)/(2a), Φ(b) = 1 + (1-b)ln(1-b)/b",
                      "references": ["doi:10.2475/ajs.s3-45.266.87",
-                                    "doi:10.1140/epje/i2010-10628-1"]})
+                                    "arXiv:1004.1037"]})
     return df
 
 
