@@ -52,3 +52,19 @@ def test_asperity_levels_next_to_percolation_runs():
     ok = ~df["trapped"].to_numpy(bool)
     assert np.all(np.isfinite(df.loc[ok, "t_star"].to_numpy(float)))
     assert np.all(df["u_inf"].to_numpy(float) > 0)
+
+
+def test_seal_lookups_agree_with_the_table_lookup_on_the_unresolved_interval():
+    # the seal engine keeps two more copies of the table's σ̄ interpolant (value + slope, and a
+    # packed copy for its innermost loop); they must take the same linear branch
+    from fastcontact.seal._lookup import _tab_sig, table_sig_d
+    from fastcontact.seal.context import seal_context
+
+    tab = load_default_tables("asphalt_072mm")
+    kd = tab.kernel_data("critical_junction")
+    sc = seal_context(tab, "critical_junction").rec
+    i = int(np.argmin(np.diff(kd.lnsig[:kd.n_open])))
+    for x in np.linspace(kd.lnp[i - 1], kd.lnp[i + 1], 301):
+        ref = k_sigma_of_lnp(kd, x)
+        assert table_sig_d(kd, x)[0] == ref
+        assert _tab_sig(sc.TQ, sc.TQB, sc.HS, x) == ref

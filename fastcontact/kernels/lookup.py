@@ -93,15 +93,22 @@ def k_lnp_of_lnu(tab, lnu_q):
 
 
 @njit(cache=True, inline="always")
-def sigma_interval_resolved(tab, i):
-    """Whether ln σ̄'s quintic on the open interval [lnp[i], lnp[i+1]] is trusted: both end
-    slopes times the width have the sign of the interval's Δ ln σ̄ and at most 3 times its size
-    (Fritsch–Carlson); else the interval is unresolved and ln σ̄ is linear across it."""
-    h = tab.lnp[i + 1] - tab.lnp[i]
-    dy = tab.lnsig[i + 1] - tab.lnsig[i]
-    s0, s1 = tab.dlnsig[i] * h, tab.dlnsig[i + 1] * h
+def sigma_interval_resolved(x0, x1, y0, y1, m0, m1):
+    """Whether ln σ̄'s quintic on the open interval [x0, x1] of ln p̄ (node values y0, y1 and
+    slopes m0, m1 of ln σ̄) is trusted: both end slopes times the width have the sign of
+    Δ ln σ̄ and at most 3 times its size (Fritsch–Carlson); else the interval is unresolved
+    and ln σ̄ is linear across it (:func:`sigma_linear`)."""
+    h = x1 - x0
+    dy = y1 - y0
+    s0, s1 = m0 * h, m1 * h
     return s0 * dy >= 0.0 and s1 * dy >= 0.0 and abs(s0) <= 3.0 * abs(dy) \
         and abs(s1) <= 3.0 * abs(dy)
+
+
+@njit(cache=True, inline="always")
+def sigma_linear(t, x0, x1, y0, y1):
+    """ln σ̄ at ln p̄ = t, linear between the nodes of an unresolved interval."""
+    return y0 + (y1 - y0) / (x1 - x0) * (t - x0)
 
 
 @njit(cache=True)
@@ -127,10 +134,10 @@ def k_sigma_of_lnp(tab, lnp_q):
     if i + 1 < n_open:
         d2 = tab.d2lnsig
         y0, y1 = lnsig[i], lnsig[i + 1]
-        if sigma_interval_resolved(tab, i):
+        if sigma_interval_resolved(lnp[i], lnp[i + 1], y0, y1, dlnsig[i], dlnsig[i + 1]):
             return math.exp(quintic_interval(lnp_q, lnp[i], lnp[i + 1], y0, y1, dlnsig[i],
                                              dlnsig[i + 1], d2[i], d2[i + 1]))
-        return math.exp(y0 + (y1 - y0) / (lnp[i + 1] - lnp[i]) * (lnp_q - lnp[i]))  # linear
+        return math.exp(sigma_linear(lnp_q, lnp[i], lnp[i + 1], y0, y1))
     j = n_open - 1
     if j < 0 or lnp_perc == math.inf:
         return 0.0

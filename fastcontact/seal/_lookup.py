@@ -18,7 +18,7 @@ from numba import njit, prange
 
 from ..kernels.hermite import quintic_interval, quintic_unit
 from ..kernels.locate import locate_asc
-from ..kernels.lookup import sigma_interval_resolved
+from ..kernels.lookup import sigma_interval_resolved, sigma_linear
 from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
 
 __all__ = ["sig_d", "table_sig_d", "sigma_of_c", "ubar_of_c", "retabulate", "verify_cells",
@@ -26,7 +26,9 @@ __all__ = ["sig_d", "table_sig_d", "sigma_of_c", "ubar_of_c", "retabulate", "ver
 
 #: slots of the hot scalars ``sc.HS`` (re-tabulation origin and step, table bottom, asymptote,
 #: ln π_perc, primitive origin and coarse step, the table's bucket map, its open nodes, ln p̄_c,
-#: 1/coarse step)
+#: 1/coarse step). A float array, not a namedtuple: numba 0.68's parfor lowering fails on a
+#: namedtuple of scalars used inside a prange body (AttributeError in
+#: _create_gufunc_for_parfor_body), and these scalars reach the innermost σ̄ lookups there.
 (H_RT0, H_RH, H_TLO, H_B0, H_B1, H_TPERC, H_ST0, H_SH, H_TQLO, H_TQDZ, H_NOPEN,
  H_LNPPERC, H_ISH) = range(13)
 H_SIZE = 13
@@ -45,9 +47,11 @@ def table_sig_d(tab, t):
         return 0.0, -math.inf
     if i + 1 < tab.n_open:
         h = lnp[i + 1] - lnp[i]
-        if not sigma_interval_resolved(tab, i):  # as k_sigma_of_lnp: linear in ln σ̄
-            dy = (tab.lnsig[i + 1] - tab.lnsig[i]) / h
-            return math.exp(tab.lnsig[i] + dy * (t - lnp[i])), dy
+        if not sigma_interval_resolved(lnp[i], lnp[i + 1], tab.lnsig[i], tab.lnsig[i + 1],
+                                       tab.dlnsig[i], tab.dlnsig[i + 1]):
+            # as k_sigma_of_lnp: linear in ln σ̄ across an unresolved interval
+            return (math.exp(sigma_linear(t, lnp[i], lnp[i + 1], tab.lnsig[i], tab.lnsig[i + 1])),
+                    (tab.lnsig[i + 1] - tab.lnsig[i]) / h)
         y, dy = quintic_unit((t - lnp[i]) / h, h, tab.lnsig[i], tab.dlnsig[i], tab.d2lnsig[i],
                              tab.lnsig[i + 1], tab.dlnsig[i + 1], tab.d2lnsig[i + 1])
         return math.exp(y), dy
@@ -105,6 +109,9 @@ def _tab_sig(TQ, TQB, HS, t):
         return 0.0
     n_open = int(HS[H_NOPEN])
     if i + 1 < n_open:
+        if not sigma_interval_resolved(TQ[i, 0], TQ[i + 1, 0], TQ[i, 1], TQ[i + 1, 1], TQ[i, 2],
+                                       TQ[i + 1, 2]):  # as k_sigma_of_lnp
+            return math.exp(sigma_linear(t, TQ[i, 0], TQ[i + 1, 0], TQ[i, 1], TQ[i + 1, 1]))
         return math.exp(quintic_interval(t, TQ[i, 0], TQ[i + 1, 0], TQ[i, 1], TQ[i + 1, 1],
                                          TQ[i, 2], TQ[i + 1, 2], TQ[i, 3], TQ[i + 1, 3]))
     j = n_open - 1
