@@ -10,7 +10,6 @@ import math
 
 import numpy as np
 
-from .._core.docs import fill_params
 from .._core.validate import check_positive, check_range
 from ..kernels.special import erfinv
 from ._checks import _check_load, _check_psd, _check_zeta
@@ -100,13 +99,17 @@ def percolation_pressure(psd, E_star, a_perc=0.5):
     return 2.0 * np.sqrt(G1) * sp_erfinv(a_perc)
 
 
-@fill_params
 def critical_magnification(psd, p, E_star, a_perc=0.5):
     """ζc, the smallest magnification with A(ζc)/A0 = a_perc [-] (critical junction, Sec. 3).
 
     Parameters
     ----------
-    {{psd p_nominal E_star}}
+    psd : PSD
+        Roughness spectrum.
+    p : array_like
+        Nominal contact pressure [Pa], > 0.
+    E_star : float or array_like
+        Effective modulus [Pa], > 0.
     a_perc : float
         Percolation threshold in (0, 1) [-] (default 0.5).
 

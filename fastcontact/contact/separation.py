@@ -11,7 +11,6 @@ import math
 
 import numpy as np
 
-from .._core.docs import fill_params
 from .._core.validate import check_positive, check_range
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.special import EULER_GAMMA, K_ZERO, k_table
@@ -49,7 +48,6 @@ def _separation(psd, p, E_star, zeta, gamma, glx=None, glw=None, panel=PANEL, se
     return out.reshape(shape), dout.reshape(shape)
 
 
-@fill_params
 def mean_separation(psd, p, E_star, zeta=1.0, gamma=1.0):
     """Mean interfacial separation ū(ζ) [m] at nominal contact pressure p (A4).
 
@@ -58,7 +56,12 @@ def mean_separation(psd, p, E_star, zeta=1.0, gamma=1.0):
 
     Parameters
     ----------
-    {{psd p_nominal E_star}}
+    psd : PSD
+        Roughness spectrum.
+    p : array_like
+        Nominal contact pressure [Pa], > 0.
+    E_star : float or array_like
+        Effective modulus [Pa], > 0.
     zeta : array_like
         Magnification in [1, ζ1] [-] (default 1: the macroscopic separation).
     gamma : float
@@ -81,13 +84,17 @@ def separation_slope(psd, p, E_star, gamma=1.0):
     return _separation(psd, p, E_star, 1.0, gamma)[1]
 
 
-@fill_params
 def u1(psd, p, E_star, zeta, gamma=1.0):
     """u1(ζ) = ū(ζ) + ū'(ζ) A(ζ)/A'(ζ) [m] (A3), in closed form from the (A4) integrals.
 
     Parameters
     ----------
-    {{psd p_nominal E_star}}
+    psd : PSD
+        Roughness spectrum.
+    p : array_like
+        Nominal contact pressure [Pa], > 0.
+    E_star : float or array_like
+        Effective modulus [Pa], > 0.
     zeta : array_like
         Magnification in [1, ζ1] [-].
     gamma : float

@@ -40,7 +40,6 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from .._core.cache import PerObjectCache
-from .._core.docs import fill_params
 from .._core.validate import check_positive
 from ..contact import area_fraction, percolation_pressure
 from .conductivity import check_emt_threshold, conductivity
@@ -62,7 +61,6 @@ __all__ = [
 ]
 
 
-@fill_params
 def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, direction="x", *,
                       form="self_consistent", gamma=1.0, a_perc=0.5, alpha_cj=1.0,
                       n_panels=N_PANELS, emt_threshold=0.5):
@@ -72,7 +70,12 @@ def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, directi
     ----------
     psd : PSD
         Angle-averaged roughness spectrum (Persson convention).
-    {{p_contact E_star_scalar eta}}
+    p : array_like
+        Contact pressure p_cont [Pa], > 0.
+    E_star : float
+        Effective modulus [Pa], > 0.
+    eta : float
+        Fluid viscosity [Pa·s], > 0.
     theory : {"emt", "critical_junction", "average"}
         Flow theory (module docstring).
     anisotropy : float

@@ -24,7 +24,6 @@ from typing import NamedTuple, Optional
 import numpy as np
 from numba import get_parallel_chunksize, set_parallel_chunksize
 
-from .._core.docs import fill_params
 from .._core.validate import check_positive, check_range
 from .._core.vocab import DEFAULT_THEORY, THEORIES
 from ..contact import _check_gamma, _check_psd, _separation, mean_separation
@@ -173,14 +172,20 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
     return SigmaBar(sig, perc, SigmaDetails(error_estimate=err, u1_evaluations=nev))
 
 
-@fill_params
 def conductivity(psd, p, E_star, eta, theory=DEFAULT_THEORY, *, gamma=1.0, a_perc=0.5,
                  alpha_cj=1.0, tol=EMT_TOL, almqvist=False, emt_threshold=0.5):
     """Effective interfacial fluid conductivity σ_eff(p_cont) [m³/(Pa·s)] by direct quadrature.
 
     Parameters
     ----------
-    {{psd p_contact E_star_scalar eta}}
+    psd : PSD
+        Roughness spectrum.
+    p : array_like
+        Contact pressure p_cont [Pa], > 0.
+    E_star : float
+        Effective modulus [Pa], > 0.
+    eta : float
+        Fluid viscosity [Pa·s], > 0.
     theory : {"average", "critical_junction", "emt"}
         Flow theory (default :data:`~fastcontact._core.vocab.DEFAULT_THEORY`,
         "critical_junction", as everywhere in the package).

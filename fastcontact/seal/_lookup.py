@@ -208,7 +208,6 @@ def verify_cells(tab, sc, tol):
     return ok, worst
 
 
-
 @njit(cache=True, parallel=True)
 def sigma_rows(tab, sc, c, out):
     """σ̄ at reduced contact pressures c (inf at c <= 0)."""
