@@ -20,7 +20,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ._lookup import H_B0, H_B1, H_ISH, H_RH, H_RT0, H_SH, H_ST0, H_TLO, _sig_fast
+from ._lookup import _sig_fast
 from ._primitive import (P_OK, P_T, _adaptive, _asym, _gl_s, _left, _right, _split, _whole,
                          asym_primitive)
 
@@ -53,11 +53,12 @@ def _gl_order(R, HS, tb, width):
     interval, z = width (A + B^(1/2) + C^(1/3) + 4) bounds the scaled derivatives of
     σ̄(π) = exp(y(ln π)) (the 4 covers the powers of π), and the relative error of the
     n-point rule is below z^2/24, z^4/4320, 4.96e-7 z^6 for n = 1, 2, 3."""
+    hs = HS[0]
     ta = tb - width
-    if ta < HS[H_TLO]:
+    if ta < hs.t_lo:
         return 0
-    rt0 = HS[H_RT0]
-    rh = HS[H_RH]
+    rt0 = hs.rt0
+    rh = hs.rh
     ub = (tb - rt0) / rh
     k = int(ub)
     if k < 0 or k >= R.shape[0] - 1 or R[k, 2] == 0.0 or int((ta - rt0) / rh) != k:
@@ -108,8 +109,9 @@ def _gl_fast(R, TQ, TQB, HS, G, hi, w, n):
 def _fast_integral(P, B, R, TQ, TQB, HS, G, hi, w):
     """∫_{hi−w}^{hi} σ̄ dπ (reduced) from verified primitive cells; NaN when an unverified
     cell is involved (then :func:`leak_integral` integrates adaptively). 0 < w <= hi."""
-    st0 = HS[H_ST0]
-    tb, ta, kb, ka, short = _split(P, B, st0, HS[H_SH], HS[H_ISH], hi, w)
+    hs = HS[0]
+    st0 = hs.st0
+    tb, ta, kb, ka, short = _split(P, B, st0, hs.sh, hs.ish, hi, w)
     if short:
         if (kb >= 0 and P[kb, P_OK] == 0.0) or (ka >= 0 and P[ka, P_OK] == 0.0):
             return math.nan
@@ -119,7 +121,7 @@ def _fast_integral(P, B, R, TQ, TQB, HS, G, hi, w):
             return (_gl_fast(R, TQ, TQB, HS, G, e0, w - wt, 0)
                     + _gl_fast(R, TQ, TQB, HS, G, hi, wt, 0))
         return _gl_fast(R, TQ, TQB, HS, G, hi, w, _gl_order(R, HS, tb, tb - ta))
-    t_lo, b0, b1 = HS[H_TLO], HS[H_B0], HS[H_B1]
+    t_lo, b0, b1 = hs.t_lo, hs.b0, hs.b1
     if kb < 0:
         return _asym(t_lo, b0, b1, tb) - _asym(t_lo, b0, b1, ta)
     top = _left(P, kb, tb)
@@ -137,7 +139,7 @@ def _slow_integral(tab, sc, hi, w):
     """As :func:`_fast_integral`, with σ̄ from :func:`sig_d` (the table's quintic in
     unverified re-tabulation cells) and unverified primitive cells integrated adaptively."""
     P = sc.P
-    tb, ta, kb, ka, short = _split(P, sc.B, sc.st0, sc.sh, sc.HS[H_ISH], hi, w)
+    tb, ta, kb, ka, short = _split(P, sc.B, sc.st0, sc.sh, sc.HS[0].ish, hi, w)
     if short:
         direct = not ((kb >= 0 and P[kb, P_OK] == 0.0) or (ka >= 0 and P[ka, P_OK] == 0.0))
         if ka < 0 <= kb:                      # split at the C¹ join with the asymptote

@@ -19,19 +19,26 @@ from numba import njit, prange
 from ..kernels.hermite import quintic_interval, quintic_unit
 from ..kernels.locate import locate_asc
 from ..kernels.lookup import sigma_interval_resolved, sigma_linear
+from ..kernels.records import scalar_record
 from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
 
 __all__ = ["sig_d", "table_sig_d", "sigma_of_c", "ubar_of_c", "retabulate", "verify_cells",
-           "sigma_rows", "ubar_rows", "contact_of_u", "H_SIZE"]
+           "sigma_rows", "ubar_rows", "contact_of_u", "HS_FIELDS", "hot_scalars"]
 
-#: slots of the hot scalars ``sc.HS`` (re-tabulation origin and step, table bottom, asymptote,
-#: ln π_perc, primitive origin and coarse step, the table's bucket map, its open nodes, ln p̄_c,
-#: 1/coarse step). A float array, not a namedtuple: numba 0.68's parfor lowering fails on a
-#: namedtuple of scalars used inside a prange body (AttributeError in
-#: _create_gufunc_for_parfor_body), and these scalars reach the innermost σ̄ lookups there.
-(H_RT0, H_RH, H_TLO, H_B0, H_B1, H_TPERC, H_ST0, H_SH, H_TQLO, H_TQDZ, H_NOPEN,
- H_LNPPERC, H_ISH) = range(13)
-H_SIZE = 13
+#: fields of the hot scalars ``sc.HS`` (re-tabulation origin and step, table bottom, asymptote,
+#: ln π_perc, primitive origin, coarse step and its inverse, the table's bucket map, its open
+#: nodes, ln p̄_c), read as ``HS[0].rt0``. A structured record (:func:`scalar_record`), not a
+#: namedtuple: numba 0.68's parfor lowering fails on a namedtuple of scalars used inside a
+#: prange body, and these scalars reach the innermost σ̄ lookups there.
+HS_FIELDS = ("rt0", "rh", "t_lo", "b0", "b1", "t_perc", "st0", "sh", "tq_lo", "tq_dz", "n_open",
+             "lnp_perc", "ish")
+
+
+def hot_scalars(**fields) -> np.ndarray:
+    """The record ``sc.HS`` from its fields (:data:`HS_FIELDS`, ``n_open`` an integer)."""
+    if set(fields) != set(HS_FIELDS):
+        raise ValueError(f"hot_scalars needs exactly the fields {HS_FIELDS}")
+    return scalar_record({k: fields[k] for k in HS_FIELDS}, ints=("n_open",))
 
 
 # =========================================================================== σ̄ and ū
@@ -96,18 +103,19 @@ def sig_d(tab, sc, t):
 def _tab_sig(TQ, TQB, HS, t):
     """σ̄ at t from the table's own interpolant on the packed copy ``TQ`` (columns ln p̄,
     ln σ̄, d ln σ̄/d ln p̄, d² ln σ̄/d(ln p̄)²) — the same arithmetic as k_sigma_of_lnp."""
+    hs = HS[0]
     n = TQ.shape[0]
     if not (TQ[0, 0] <= t <= TQ[n - 1, 0]):
         return math.nan
-    c = int((t - HS[H_TQLO]) / HS[H_TQDZ])
+    c = int((t - hs.tq_lo) / hs.tq_dz)
     c = min(max(c, 0), TQB.size - 1)
     i = TQB[c]
     while i < n - 2 and TQ[i + 1, 0] < t:
         i += 1
-    lnp_perc = HS[H_LNPPERC]
+    lnp_perc = hs.lnp_perc
     if t >= lnp_perc:
         return 0.0
-    n_open = int(HS[H_NOPEN])
+    n_open = hs.n_open
     if i + 1 < n_open:
         if not sigma_interval_resolved(TQ[i, 0], TQ[i + 1, 0], TQ[i, 1], TQ[i + 1, 1], TQ[i, 2],
                                        TQ[i + 1, 2]):  # as k_sigma_of_lnp
@@ -125,14 +133,15 @@ def _tab_sig(TQ, TQB, HS, t):
 def _sig_fast(R, TQ, TQB, HS, t):
     """σ̄ at t (value only): the asymptote below the table, the verified re-tabulation
     (``R`` columns ln σ̄, d ln σ̄/dt, cell verified), else the table's own quintic."""
-    t_lo = HS[H_TLO]
+    hs = HS[0]
+    t_lo = hs.t_lo
     if t < t_lo:
-        s = HS[H_B0] + HS[H_B1] * (t_lo - t)
+        s = hs.b0 + hs.b1 * (t_lo - t)
         return s * s * s
-    if t >= HS[H_TPERC]:
+    if t >= hs.t_perc:
         return 0.0
-    rh = HS[H_RH]
-    u = (t - HS[H_RT0]) / rh
+    rh = hs.rh
+    u = (t - hs.rt0) / rh
     k = int(u)
     if k < 0 or k >= R.shape[0] - 1 or R[k, 2] == 0.0:
         return _tab_sig(TQ, TQB, HS, t)

@@ -74,7 +74,8 @@ class SealRecord(NamedTuple):
     R, TQ, TQB, HS, G : ndarray
         Packed copies for the flat-ring kernel: R = (ln σ̄, d ln σ̄/dt, cell verified) per
         re-tabulation node; TQ = the table's (ln p̄, ln σ̄, d ln σ̄, d² ln σ̄) per node and
-        TQB its bucket map; HS the scalars (slots ``_sigma.H_*``); G = (glx, glw).
+        TQB its bucket map; HS the hot scalars (record, fields ``_sigma.HS_FIELDS``);
+        G = (glx, glw).
     h_rms : float
         rms roughness [m].
     p_perc, p_top : float
@@ -194,7 +195,8 @@ class SealContext:
                          lns, dlns, np.ones(nret - 1, dtype=np.bool_), t_lo, sh, t_top,
                          t_trust, self.pi_trust, sig_trust, P0, np.zeros(2, dtype=np.int64),
                          np.ascontiguousarray(glx), np.ascontiguousarray(glw), P0, P0,
-                         np.zeros(2, dtype=np.int64), np.zeros(_sigma.H_SIZE), P0, self.h_rms,
+                         np.zeros(2, dtype=np.int64),
+                         _sigma.hot_scalars(**dict.fromkeys(_sigma.HS_FIELDS, 0)), P0, self.h_rms,
                          p_perc, float(hi))
         ok, worst = _sigma.verify_cells(self.tab, rec, RETAB_TOL)
         rec = rec._replace(ok=ok)
@@ -211,12 +213,10 @@ class SealContext:
             tn = np.concatenate((tn, tail[tail < t_top - 1e-3 * fh], [t_top]))
         P = _sigma.build_primitive(self.tab, rec, np.ascontiguousarray(tn), n_ver, PRIM_DEPTH)
         tab = self.tab
-        HS = np.zeros(_sigma.H_SIZE)
-        HS[[_sigma.H_RT0, _sigma.H_RH, _sigma.H_TLO, _sigma.H_B0, _sigma.H_B1, _sigma.H_TPERC,
-            _sigma.H_ST0, _sigma.H_SH, _sigma.H_TQLO, _sigma.H_TQDZ, _sigma.H_NOPEN,
-            _sigma.H_LNPPERC, _sigma.H_ISH]] = (rec.rt0, rec.rh, t_lo, rec.b0, rec.b1, t_perc,
-                                                t_lo, sh, tab.bp_lo, tab.bp_dz, tab.n_open,
-                                                tab.lnp_perc, 1.0 / sh)
+        HS = _sigma.hot_scalars(rt0=rec.rt0, rh=rec.rh, t_lo=t_lo, b0=rec.b0, b1=rec.b1,
+                                t_perc=t_perc, st0=t_lo, sh=sh, tq_lo=tab.bp_lo,
+                                tq_dz=tab.bp_dz, n_open=tab.n_open, lnp_perc=tab.lnp_perc,
+                                ish=1.0 / sh)
         self.rec = rec._replace(
             P=P, B=_bucket_map(np.ascontiguousarray(P[:, _sigma.P_T]), t_lo, sh),
             R=np.ascontiguousarray(np.column_stack((lns, dlns, np.append(ok, False)))),
