@@ -22,7 +22,8 @@ doi:10.1063/1.1388626.
 from __future__ import annotations
 
 # private checks re-exported for flow and tables
-from ._checks import _arrays, _check_gamma, _check_load, _check_psd, _check_zeta  # noqa: F401
+from ._checks import (PBAR_MIN, _arrays, _check_gamma, _check_load, _check_pbar,  # noqa: F401
+                      _check_psd, _check_zeta)
 from .area import area_fraction, critical_magnification, percolation_pressure, stiffness_G
 from .elasticity import effective_modulus  # noqa: F401
 from .separation import (_separation, asymptote, asymptote_self_affine,  # noqa: F401

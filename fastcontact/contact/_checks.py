@@ -5,7 +5,12 @@ from .._core.validate import check_positive, check_range
 from ..surface.psd import PSD
 from ._kernels import psd_kernel
 
-__all__ = ["_check_psd", "_check_load", "_check_gamma", "_check_zeta", "_arrays"]
+__all__ = ["_check_psd", "_check_load", "_check_gamma", "_check_zeta", "_arrays", "_check_pbar",
+           "PBAR_MIN"]
+
+#: smallest reduced pressure p/E* the direct quadrature accepts: below it G(ζ)/E*² ∝ (p/E*)²
+#: underflows in float64 (ū ≈ 400 h_rms on a typical surface, far beyond any table)
+PBAR_MIN = 1e-150
 
 
 def _check_psd(psd):
@@ -40,6 +45,16 @@ def _check_load(psd, p, E_star, p_name="p", p_unit="[Pa]"):
     """
     _check_psd(psd)
     return check_positive(p_name, p, p_unit), check_positive("E_star", E_star, "[Pa]")
+
+
+def _check_pbar(pbar, p_name="p"):
+    """ValueError naming ``p_name`` if a reduced pressure p/E* is below :data:`PBAR_MIN`."""
+    low = pbar < PBAR_MIN
+    if low.any():
+        v = float(pbar[low][0])
+        raise ValueError(f"{p_name}/E_star = {v!r} is invalid: the direct quadrature needs "
+                         f"p/E_star >= {PBAR_MIN:g} (below it G(zeta)/E*^2 underflows)")
+    return pbar
 
 
 def _check_gamma(gamma):

@@ -12,7 +12,7 @@ import numpy as np
 
 from .._core.validate import check_positive, check_range
 from ..kernels.special import erfinv
-from ._checks import _check_load, _check_psd, _check_zeta
+from ._checks import _check_load, _check_pbar, _check_psd, _check_zeta
 from ._kernels import q_for_m3
 
 __all__ = ["stiffness_G", "area_fraction", "percolation_pressure", "critical_magnification"]
@@ -121,7 +121,7 @@ def critical_magnification(psd, p, E_star, a_perc=0.5):
     p, E_star = _check_load(psd, p, E_star)
     a_perc = float(check_range("a_perc", a_perc, 0.0, 1.0, "[-]", lo_open=True, hi_open=True))
     pb, Eb = np.broadcast_arrays(p, E_star)
-    pbar = (pb / Eb).ravel()
+    pbar = _check_pbar((pb / Eb).ravel())
     x = float(erfinv(a_perc))
     target = 4.0 / math.pi * (pbar / (2.0 * x)) ** 2
     qb, c, e, cum3 = psd.kernel_arrays()

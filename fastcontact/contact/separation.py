@@ -14,7 +14,7 @@ import numpy as np
 from .._core.validate import check_positive, check_range
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.special import EULER_GAMMA, K_ZERO, k_table
-from ._checks import _check_gamma, _check_load, _check_psd, _check_zeta
+from ._checks import _check_gamma, _check_load, _check_pbar, _check_psd, _check_zeta
 from ._kernels import (PANEL, asymptote_kernel, contact_pressure_kernel, mean_separation_kernel,
                        psd_kernel, u1_kernel)
 
@@ -28,7 +28,7 @@ def _reduced_inputs(psd, p, E_star, zeta, gamma):
     zeta = _check_zeta(psd, zeta)
     gamma = _check_gamma(gamma)
     pb, Eb, zb = np.broadcast_arrays(p, E_star, zeta)
-    pbar = np.ascontiguousarray((pb / Eb).ravel(), dtype=np.float64)
+    pbar = _check_pbar(np.ascontiguousarray((pb / Eb).ravel(), dtype=np.float64))
     z = np.ascontiguousarray(zb.ravel(), dtype=np.float64)
     return pb.shape, pbar, z, gamma
 
@@ -59,7 +59,8 @@ def mean_separation(psd, p, E_star, zeta=1.0, gamma=1.0):
     psd : PSD
         Roughness spectrum.
     p : array_like
-        Nominal contact pressure [Pa], > 0.
+        Nominal contact pressure [Pa], > 0, with p/E* >= 1e-150 (below, the quadrature
+        underflows: ValueError).
     E_star : float or array_like
         Effective modulus [Pa], > 0.
     zeta : array_like

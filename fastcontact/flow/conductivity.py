@@ -26,7 +26,7 @@ from numba import get_parallel_chunksize, set_parallel_chunksize
 
 from .._core.validate import check_positive, check_range
 from .._core.vocab import DEFAULT_THEORY, THEORIES
-from ..contact import _check_gamma, _check_psd, _separation, mean_separation
+from ..contact import _check_gamma, _check_pbar, _check_psd, _separation, mean_separation
 from ..contact._kernels import PANEL, psd_kernel
 from ..kernels.quadrature import gauss_hermite, gauss_legendre
 from ..kernels.special import k_table
@@ -128,7 +128,8 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
     psd : PSD
         Roughness spectrum.
     pbar : array_like
-        Reduced contact pressures p/E* [-], > 0 (flattened).
+        Reduced contact pressures p/E* [-], >= 1e-150 (flattened; PBAR_MIN, below which the
+        quadrature underflows).
     theory : {"average", "critical_junction", "emt"}
         Flow theory.
     gamma, a_perc, alpha_cj, tol, almqvist, emt_threshold
@@ -145,7 +146,7 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
     """
     check_theory(theory)
     emt_threshold = check_emt_threshold(emt_threshold)
-    pbar = np.ascontiguousarray(np.asarray(pbar, dtype=np.float64).ravel())
+    pbar = _check_pbar(np.ascontiguousarray(np.asarray(pbar, dtype=np.float64).ravel()))
     h = psd.h_rms
     if glx is None:
         glx, glw = gauss_legendre()
@@ -181,7 +182,7 @@ def conductivity(psd, p, E_star, eta, theory=DEFAULT_THEORY, *, gamma=1.0, a_per
     psd : PSD
         Roughness spectrum.
     p : array_like
-        Contact pressure p_cont [Pa], > 0.
+        Contact pressure p_cont [Pa], > 0, with p/E* >= 1e-150.
     E_star : float
         Effective modulus [Pa], > 0.
     eta : float

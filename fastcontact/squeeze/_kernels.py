@@ -44,12 +44,23 @@ def trapped_mask(status, u_trap):
 
 
 @njit(cache=True)
+def tail_sigma(mp, v):
+    """(σ̄, d ln σ̄/d ln v) of the analytic tail above the table top at v > v_top [h_rms]:
+    σ̄ = y (y² - cn), y = v + d + g(1/v), g(x) = x (g1 + x (g2 + ... + x g5)) (model.py)."""
+    x = 1.0 / v
+    g = x * (mp.g1 + x * (mp.g2 + x * (mp.g3 + x * (mp.g4 + x * mp.g5))))
+    dg = mp.g1 + x * (2.0 * mp.g2 + x * (3.0 * mp.g3 + x * (4.0 * mp.g4 + x * 5.0 * mp.g5)))
+    y = v + mp.d + g
+    y2c = y * y - mp.cn
+    return y * y2c, v * (1.0 - x * x * dg) * (3.0 * y * y - mp.cn) / (y * y2c)
+
+
+@njit(cache=True)
 def _state(tab, mp, v):
     """(ln π_c, σ̄) at separation v [h_rms]: tables, or the analytic tail above v_top."""
     v_top = mp.v_top
     if v > v_top:
-        y = v + mp.d
-        return mp.x_min - (v - v_top) / mp.u0, y * (y * y - mp.c)
+        return mp.x_min - (v - v_top) / mp.u0, tail_sigma(mp, v)[0]
     lnp = k_lnp_of_lnu(tab, math.log(v))
     if lnp != lnp:
         return lnp, math.nan

@@ -75,10 +75,8 @@ def _pstate(pf, mp, v):
     """(ln π_c, ln σ̄, d ln π_c/d ln v, d ln σ̄/d ln v) at v: the profile below the table
     top, the analytic tail above."""
     if v > mp.v_top:
-        y = v + mp.d
-        y2c = y * y - mp.c
-        return (mp.x_min - (v - mp.v_top) / mp.u0, math.log(y * y2c), -v / mp.u0,
-                v * (3.0 * y * y - mp.c) / (y * y2c))
+        sig, dls = qk.tail_sigma(mp, v)
+        return mp.x_min - (v - mp.v_top) / mp.u0, math.log(sig), -v / mp.u0, dls
     u = (math.log(v) - pf.s0) / pf.ds
     i = int(u)
     A = pf.A

@@ -20,7 +20,7 @@ from ._primitive_eval import Primitive, _index_map
 __all__ = ["load_or_build", "write", "read", "set_primitive_cache", "primitive_path",
            "PRIMITIVE_VERSION"]
 
-PRIMITIVE_VERSION = 1
+PRIMITIVE_VERSION = 2
 _CACHE_ATTR = "_squeeze_primitive_dir"
 
 

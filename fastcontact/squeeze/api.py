@@ -157,13 +157,25 @@ def attrs(model, cols, method):
                            f"(p/E* >= {math.exp(xt) if np.isfinite(xt) else math.inf:.8g}; "
                            f"exact percolation at p/E* = "
                            f"{math.exp(xp) if np.isfinite(xp) else math.inf:.8g})"),
-        "tail": (f"u > {model.v_top:.6g} h_rms: p = p_top exp(-(u-u_top)/{model.u0:.6g} h_rms), "
-                 f"sigma_bar = y^3 - {model.c_tail:.6g} y, y = u/h_rms + {model.d_tail:.6g}"),
+        "tail": _tail_text(model),
         "status": {"ok": "computed", "trapped": "fluid trapped above u_inf (u_trap, t_trap)",
                    "out_of_table": "p0/E_star outside the tables: NaN",
                    "start_below_equilibrium": "u_start <= u_inf: NaN",
                    "overflow": "tau0 or a time not representable in float64 (inf or 0)"},
     }
+
+
+def _tail_text(model):
+    """Provenance text of the model's analytic tail above the table top."""
+    t, mp = model.tail, model.mp
+    head = f"u > {model.v_top:.6g} h_rms: p = p_top exp(-(u-u_top)/{model.u0:.6g} h_rms), "
+    far = f"sigma_bar = y^3 - {mp.c:.6g} y, y = u/h_rms + {mp.d:.6g}"
+    if "fit_error" not in t:
+        return head + far + " (matched to the table top in value and slope)"
+    g = ", ".join(f"{t[k]:.6g}" for k in ("g1", "g2", "g3", "g4", "g5"))
+    return (head + f"sigma_bar^(1/3) = u/h_rms + {mp.d:.6g} + g(h_rms/u), g = polynomial "
+            f"with coefficients ({g}) fitted to the tables' tail samples (worst residual "
+            f"{t['fit_error']:.2g}); above u = {mp.v_ext:.6g} h_rms " + far)
 
 
 def squeeze_out(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=None,

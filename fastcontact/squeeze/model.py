@@ -7,6 +7,7 @@ arXiv:1004.1037.
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 import threading
 import time as _clock
@@ -26,14 +27,22 @@ __all__ = ["ModelPar", "SqueezeModel", "squeeze_model", "DEFAULT_P_START", "TAIL
 DEFAULT_P_START = 1e-3
 #: extent of the analytic tail above the table top, in units of u0 (π drops by e^-40)
 TAIL_EXTENT = 40.0
+#: the closed-form tail starts where it is within TAIL_TOL (relative σ̄) of the fitted tail
+#: everywhere above (v_ext grows by TAIL_GROWTH until it is)
+TAIL_TOL = 1e-8
+TAIL_GROWTH = 1.25
+#: degree of the tail's polynomial g(h_rms/ū) fitted to the tables' tail samples
+TAIL_DEGREE = 5
 
 #: scalar model parameters (reduced units) passed to the kernels:
 #: x_min, x_max  ln p̄ range of the tables; v_top, u0  ū/h_rms at the table top and the decay
-#: length of eq. (3) there; c, d  the tail σ̄ = y³ - c y, y = v + d; x_trap  ln π where σ̄
-#: falls to sigma_trap (inf: never); v_ext  start of the closed-form tail; x_perc  ln of the
-#: exact percolation pressure; v_trap  separation at x_trap; lnp_start  ln DEFAULT_P_START
+#: length of eq. (3) there; c, d  the closed-form tail σ̄ = y³ - c y, y = v + d, above v_ext;
+#: x_trap  ln π where σ̄ falls to sigma_trap (inf: never); v_ext  start of the closed-form
+#: tail; x_perc  ln of the exact percolation pressure; v_trap  separation at x_trap;
+#: lnp_start  ln DEFAULT_P_START; cn, g1..g5  the tail between v_top and v_ext,
+#: σ̄ = y (y² - cn), y = v + d + g(1/v), g(x) = g1 x + ... + g5 x⁵ (see :func:`_tail_fit`)
 ModelPar = namedtuple("ModelPar", "x_min x_max v_top u0 c x_trap v_ext x_perc v_trap "
-                                  "lnp_start d")
+                                  "lnp_start d cn g1 g2 g3 g4 g5")
 
 
 def _ev(kernel, *args):
@@ -43,9 +52,16 @@ def _ev(kernel, *args):
     return out
 
 
-def _tail_fit(tab, x_min):
-    """(v_top, u0, c, d): the table top and the analytic tail matched to it in value and
-    slope (σ̄ = y³ - c y, y = v + d; leading order σ̄ = v³ is exact above the roughness)."""
+def _tail_fit(tab, x_min, samples=None, theory=None):
+    """The table top and the analytic tail above it: (v_top, u0, tail) with tail a dict of
+    the ModelPar fields c, d, cn, g1..g5, v_ext (v_ext None: v_top + TAIL_EXTENT u0).
+
+    With the tables' tail samples (``info["tail"]``: direct ū and σ̄ below the lowest table
+    pressure, up to ~340 h_rms), σ̄^(1/3) = v + d + g(1/v) is fitted to them and to the
+    table top (:func:`_sample_tail`); tables without samples get the old two-parameter tail
+    σ̄ = y³ - c y, y = v + d, matched to the top in value and slope (leading order σ̄ = v³ is
+    exact above the roughness; the effective medium's correction -2.2/v² is not of that
+    form, so such tables are accurate to ~1e-5 in σ̄ above the top, not 1e-8)."""
     ev_u = _ev(qk.lnu_kernel, tab, np.array([x_min, x_min + 1e-4]))
     v_top = math.exp(ev_u[0])
     u0 = -(math.exp(ev_u[1]) - v_top) / 1e-4          # -dv/dln p at the top
@@ -65,7 +81,49 @@ def _tail_fit(tab, x_min):
     c = 3 * y * y - s1
     if not (abs(d) < 0.1 * v_top and abs(c) < 0.1 * y * y):   # fall back: value only
         d, c = 0.0, v_top ** 2 - sig_top / v_top
-    return v_top, u0, c, d
+    tail = dict(c=c, d=d, cn=c, g1=0.0, g2=0.0, g3=0.0, g4=0.0, g5=0.0, v_ext=None)
+    if samples is not None and theory in samples.get("sigma_bar", {}):
+        tail = _sample_tail(samples, theory, v_top, sig_top, v_top + TAIL_EXTENT * u0)
+    return v_top, u0, tail
+
+
+def _sample_tail(samples, theory, v_top, sig_top, v_ext):
+    """The tail fitted to the tables' tail samples: σ̄^(1/3) = v + g0 + g(1/v), g a polynomial
+    of degree TAIL_DEGREE in 1/v (least squares; the table top weighted 1e3, so continuous
+    to ~1e-10), and the closed form σ̄ = y³ - c y, y = v + g0, above v_ext, with c matched to
+    the fit at v_ext and v_ext raised until the two agree to TAIL_TOL everywhere above.
+
+    "average" is σ̄ = v³ exactly (no fit). The fit's worst relative σ̄ residual on the
+    samples goes into ``fit_error`` (~1e-10 on the embedded tables)."""
+    if theory == "average":
+        return dict(c=0.0, d=0.0, cn=0.0, g1=0.0, g2=0.0, g3=0.0, g4=0.0, g5=0.0, v_ext=v_ext,
+                    fit_error=0.0)
+    v = np.concatenate(([v_top], np.asarray(samples["u_over_h"], dtype=np.float64)))
+    sig = np.concatenate(([sig_top], np.asarray(samples["sigma_bar"][theory], dtype=np.float64)))
+    x = 1.0 / v
+    g = np.cbrt(sig) - v
+    deg = int(min(TAIL_DEGREE, v.size - 2))
+    w = np.ones(v.size)
+    w[0] = 1e3
+    A = np.vander(x, deg + 1, increasing=True)
+    coef = np.linalg.lstsq(A * w[:, None], g * w, rcond=None)[0]
+    coef = np.concatenate((coef, np.zeros(TAIL_DEGREE + 1 - coef.size)))
+    fit_error = float(np.max(np.abs((v + A @ coef[:deg + 1]) ** 3 / sig - 1.0)))
+    d = float(coef[0])
+
+    def near(vv):
+        return (vv + np.polynomial.polynomial.polyval(1.0 / vv, coef)) ** 3
+
+    for _ in range(200):
+        y = v_ext + d
+        c = float((y ** 3 - near(v_ext)) / y)
+        vv = np.geomspace(v_ext, 1e6 * v_ext, 2000)
+        yy = vv + d
+        if np.max(np.abs((yy ** 3 - c * yy) / near(vv) - 1.0)) < TAIL_TOL:
+            break
+        v_ext *= TAIL_GROWTH
+    return dict(c=c, d=d, cn=0.0, g1=float(coef[1]), g2=float(coef[2]), g3=float(coef[3]),
+                g4=float(coef[4]), g5=float(coef[5]), v_ext=float(v_ext), fit_error=fit_error)
 
 
 class SqueezeModel:
@@ -92,18 +150,22 @@ class SqueezeModel:
         x_min, x_max = math.log(p_lo), math.log(p_hi)
         self.sigma_trap = float(tables.info.get("sigma_floor", 1e-24) if sigma_trap is None
                                 else sigma_trap)
-        v_top, u0, c, d = _tail_fit(tab, x_min)
+        v_top, u0, tail = _tail_fit(tab, x_min, tables.info.get("tail"), theory)
+        c, d = tail["c"], tail["d"]
+        v_ext = v_top + TAIL_EXTENT * u0 if tail["v_ext"] is None else tail["v_ext"]
         perc = tables.info["percolation_p_over_E"][theory]
         x_perc = math.log(perc) if np.isfinite(perc) else math.inf
         x_trap = self._find_trap(tab, x_min, x_max, x_perc)
-        mp = ModelPar(x_min, x_max, v_top, u0, c, x_trap, v_top + TAIL_EXTENT * u0, x_perc,
-                      math.nan, math.log(DEFAULT_P_START), d)
+        mp = ModelPar(x_min, x_max, v_top, u0, c, x_trap, v_ext, x_perc,
+                      math.nan, math.log(DEFAULT_P_START), d, tail["cn"], tail["g1"],
+                      tail["g2"], tail["g3"], tail["g4"], tail["g5"])
         if np.isfinite(x_trap):
             v_trap = math.exp(_ev(qk.lnv_of_lnp_kernel, tab, mp, np.array([x_trap]))[0])
             mp = mp._replace(v_trap=v_trap)
         self.mp = mp
         self.x_min, self.x_max, self.x_trap, self.x_perc = x_min, x_max, x_trap, x_perc
         self.v_top, self.u0, self.c_tail, self.d_tail = v_top, u0, c, d
+        self.tail = tail
         self._prim = None
         self._lock = threading.Lock()
         self.setup_seconds = _clock.perf_counter() - t_start
@@ -142,7 +204,8 @@ class SqueezeModel:
         t = self.tables
         raw = repr((t.surface.fingerprint(), tuple(t.theories), t.p_range,
                     int(t.info.get("nodes", -1)), sorted(t.options.items()), self.theory,
-                    self.sigma_trap, prim.PRIMITIVE_VERSION, _digest(t)))
+                    self.sigma_trap, prim.PRIMITIVE_VERSION, _digest(t),
+                    json.dumps(t.info.get("tail"), sort_keys=True)))
         return hashlib.sha256(raw.encode()).hexdigest()[:32]
 
 

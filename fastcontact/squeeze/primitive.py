@@ -10,8 +10,9 @@ T is tabulated as ln T on a grid in x0 (nodes uniform in ξ = x0 - ln σ̄(x0), 
 σ̄ collapses) × z = ln(v/v∞ - 1) (uniform), with its exact z-derivatives from the integrand,
 so that z-interpolation is quintic Hermite and x0-interpolation 4-point Lagrange. Below
 the grid (the logarithmic singularity at v∞) T = T0 + S (z0 - z) + (h0 - S)(1 - e^{z - z0})
-analytically; above v_ext (the flat-film tail, σ̄ = y³ - c y with π_c/π0 < e^-40) T is the
-closed form ∫dy/(y³ - c y). The inverse (v at a given T) is a bracketed Newton solve on the
+analytically. Between the table top and v_ext σ̄ is the tail fitted to the tables' direct
+samples (:mod:`.model`); above v_ext (the flat-film tail, σ̄ = y³ - c y within 1e-8 of that
+fit, π_c/π0 < e^-40) T is the closed form ∫dy/(y³ - c y). The inverse (v at a given T) is a bracketed Newton solve on the
 same interpolant, so forward and inverse agree to rounding and ū(t) is monotone.
 
 A primitive is built in one parallel pass (node quadrature, composite Gauss–Legendre in z),

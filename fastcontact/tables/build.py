@@ -36,6 +36,10 @@ TOLERANCE = {"u": 5e-9, "p_of_u": 5e-9, "slope": 5e-8, "sigma": 2e-7}
 #: σ̄ below this is "at percolation" for the refinement (not resolved further; time scales
 #: there exceed 1e20 τ-units)
 SIGMA_FLOOR = 1e-24
+#: tail samples: direct ū and σ̄ at ln p̄ = (lowest node) - TAIL_STEPS, below the table (ū from
+#: 32 to ~340 h_rms), stored in ``info["tail"]`` for the squeeze-out engine's large-separation
+#: tail (the effective medium's σ̄/ū³ - 1 ≈ -2.2/ū² has no closed form)
+TAIL_STEPS = (1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0, 256.0)
 BOUNDARY_FACTOR = 1e3
 MAX_NODES = 6000
 MIN_DLNP = 1e-6
@@ -394,6 +398,8 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
     lnp, cols, errs, stats = _refine(psd, grid, theories, _sigma_options(options), tol, refine)
     data, perc_p, zg = _assemble(psd, lnp, cols, theories, options)
     info = _info(psd, options["gamma"], perc_p, errs, tol, lnp.size, stats, t_start, cal_block)
+    info["tail"] = _tail_samples(psd, float(lnp[0]), theories, _sigma_options(options))
+    info["build_seconds"] = time.perf_counter() - t_start
     tables = Tables(psd, theories, options, grid, zg, data, info)
     return tables if aniso is None else _with_directional(tables, aniso, t_start)
 
@@ -426,6 +432,25 @@ def _sigma_options(options):
     return dict(gamma=options["gamma"], a_perc=options["a_perc"], alpha_cj=options["alpha_cj"],
                 tol=options["emt_tol"], almqvist=options["emt_almqvist"],
                 emt_threshold=options.get("emt_threshold", 0.5))
+
+
+def _tail_samples(psd, lnp_lo, theories, sig_opts):
+    """Direct ū/h_rms and σ̄ at ln p̄ = lnp_lo - :data:`TAIL_STEPS` (below the table): the data
+    the squeeze-out engine fits its large-separation tail σ̄^(1/3) = ū/h_rms + g(h_rms/ū) to.
+
+    Returns a JSON-able dict {"ln_p_over_E": [...], "u_over_h": [...], "sigma_bar": {theory:
+    [...]}}; samples where the quadrature is not finite (ū beyond float range) are dropped.
+    """
+    lnp = lnp_lo - np.asarray(TAIL_STEPS, dtype=np.float64)
+    pbar = np.exp(lnp)
+    u, _du = _separation(psd, pbar, 1.0, 1.0, sig_opts["gamma"])
+    v = u / psd.h_rms
+    sig = {}
+    for th in theories:
+        sig[th] = v ** 3 if th == "average" else sigma_bar(psd, pbar, th, **sig_opts).sigma_bar
+    ok = np.isfinite(v) & (v > 0) & np.all([np.isfinite(s) & (s > 0) for s in sig.values()], axis=0)
+    return {"ln_p_over_E": lnp[ok].tolist(), "u_over_h": v[ok].tolist(),
+            "sigma_bar": {th: np.asarray(s)[ok].tolist() for th, s in sig.items()}}
 
 
 def _info(psd, gamma, perc_p, errs, tol, nodes, stats, t_start, cal_block):
