@@ -22,7 +22,7 @@ from fastcontact.contact import contact_pressure  # noqa: E402
 from fastcontact.flow.conductivity import sigma_bar  # noqa: E402
 from fastcontact.squeeze import squeeze_model, squeeze_out  # noqa: E402
 from fastcontact.squeeze import _kernels as qk  # noqa: E402
-from fastcontact.squeeze.model import TAIL_TOL  # noqa: E402
+from fastcontact.tables.tail import TAIL_TOL  # noqa: E402
 from fastcontact.tables import Tables, precompute  # noqa: E402
 from fastcontact.tables.defaults import default_surface  # noqa: E402
 

@@ -18,6 +18,7 @@ import numpy as np
 
 from .._core.vocab import DEFAULT_THEORY
 from ..tables import Tables
+from ..tables.tail import fit_tail
 from . import _kernels as qk
 from . import primitive as prim
 
@@ -27,12 +28,6 @@ __all__ = ["ModelPar", "SqueezeModel", "squeeze_model", "DEFAULT_P_START", "TAIL
 DEFAULT_P_START = 1e-3
 #: extent of the analytic tail above the table top, in units of u0 (π drops by e^-40)
 TAIL_EXTENT = 40.0
-#: the closed-form tail starts where it is within TAIL_TOL (relative σ̄) of the fitted tail
-#: everywhere above (v_ext grows by TAIL_GROWTH until it is)
-TAIL_TOL = 1e-8
-TAIL_GROWTH = 1.25
-#: degree of the tail's polynomial g(h_rms/ū) fitted to the tables' tail samples
-TAIL_DEGREE = 5
 
 #: scalar model parameters (reduced units) passed to the kernels:
 #: x_min, x_max  ln p̄ range of the tables; v_top, u0  ū/h_rms at the table top and the decay
@@ -58,7 +53,7 @@ def _tail_fit(tab, x_min, samples=None, theory=None):
 
     With the tables' tail samples (``info["tail"]``: direct ū and σ̄ below the lowest table
     pressure, up to ~340 h_rms), σ̄^(1/3) = v + d + g(1/v) is fitted to them and to the
-    table top (:func:`_sample_tail`); tables without samples get the old two-parameter tail
+    table top (:func:`fastcontact.tables.tail.fit_tail`); tables without samples get the old two-parameter tail
     σ̄ = y³ - c y, y = v + d, matched to the top in value and slope (leading order σ̄ = v³ is
     exact above the roughness; the effective medium's correction -2.2/v² is not of that
     form, so such tables are accurate to ~1e-5 in σ̄ above the top, not 1e-8)."""
@@ -83,47 +78,8 @@ def _tail_fit(tab, x_min, samples=None, theory=None):
         d, c = 0.0, v_top ** 2 - sig_top / v_top
     tail = dict(c=c, d=d, cn=c, g1=0.0, g2=0.0, g3=0.0, g4=0.0, g5=0.0, v_ext=None)
     if samples is not None and theory in samples.get("sigma_bar", {}):
-        tail = _sample_tail(samples, theory, v_top, sig_top, v_top + TAIL_EXTENT * u0)
+        tail = fit_tail(samples, theory, v_top, sig_top, v_top + TAIL_EXTENT * u0)
     return v_top, u0, tail
-
-
-def _sample_tail(samples, theory, v_top, sig_top, v_ext):
-    """The tail fitted to the tables' tail samples: σ̄^(1/3) = v + g0 + g(1/v), g a polynomial
-    of degree TAIL_DEGREE in 1/v (least squares; the table top weighted 1e3, so continuous
-    to ~1e-10), and the closed form σ̄ = y³ - c y, y = v + g0, above v_ext, with c matched to
-    the fit at v_ext and v_ext raised until the two agree to TAIL_TOL everywhere above.
-
-    "average" is σ̄ = v³ exactly (no fit). The fit's worst relative σ̄ residual on the
-    samples goes into ``fit_error`` (~1e-10 on the embedded tables)."""
-    if theory == "average":
-        return dict(c=0.0, d=0.0, cn=0.0, g1=0.0, g2=0.0, g3=0.0, g4=0.0, g5=0.0, v_ext=v_ext,
-                    fit_error=0.0)
-    v = np.concatenate(([v_top], np.asarray(samples["u_over_h"], dtype=np.float64)))
-    sig = np.concatenate(([sig_top], np.asarray(samples["sigma_bar"][theory], dtype=np.float64)))
-    x = 1.0 / v
-    g = np.cbrt(sig) - v
-    deg = int(min(TAIL_DEGREE, v.size - 2))
-    w = np.ones(v.size)
-    w[0] = 1e3
-    A = np.vander(x, deg + 1, increasing=True)
-    coef = np.linalg.lstsq(A * w[:, None], g * w, rcond=None)[0]
-    coef = np.concatenate((coef, np.zeros(TAIL_DEGREE + 1 - coef.size)))
-    fit_error = float(np.max(np.abs((v + A @ coef[:deg + 1]) ** 3 / sig - 1.0)))
-    d = float(coef[0])
-
-    def near(vv):
-        return (vv + np.polynomial.polynomial.polyval(1.0 / vv, coef)) ** 3
-
-    for _ in range(200):
-        y = v_ext + d
-        c = float((y ** 3 - near(v_ext)) / y)
-        vv = np.geomspace(v_ext, 1e6 * v_ext, 2000)
-        yy = vv + d
-        if np.max(np.abs((yy ** 3 - c * yy) / near(vv) - 1.0)) < TAIL_TOL:
-            break
-        v_ext *= TAIL_GROWTH
-    return dict(c=c, d=d, cn=0.0, g1=float(coef[1]), g2=float(coef[2]), g3=float(coef[3]),
-                g4=float(coef[4]), g5=float(coef[5]), v_ext=float(v_ext), fit_error=fit_error)
 
 
 class SqueezeModel:
