@@ -408,8 +408,10 @@ def seal_refs(tables, rng, n_ref, budget):
                 pH = math.exp(rng.uniform(math.log(lo) + 3, math.log(top))) * E
                 fN = math.pi * R * pH ** 2 / E
                 dp = rng.uniform(0.05, 0.95) * pH
-                si = SigmaInterp(psd, E_star=E, eta=eta, theory=theory, p_lo=1e-16 * E,
-                                 p_hi=pH)
+                # the reference clips σ below p_lo: keep p_lo far below the contact's p_H
+                # (p_lo = 1e-16 E* put the 2026-11-25 reference 1.9e-6 off at p_H = 2.4e-13 E*)
+                si = SigmaInterp(psd, E_star=E, eta=eta, theory=theory,
+                                 p_lo=min(1e-16, 1e-6 * pH / E) * E, p_hi=pH)
                 want, _, _ = hertz_reference(si, R=R, f_N=fN, dp=dp, L_y=L_y, E_star=E)
                 got = float(seal_leak(tab, R=R, f_N=fN, dp=dp, L_y=L_y, E_star=E, eta=eta,
                                       theory=theory, profile="hertz")["Q"].iloc[0])
