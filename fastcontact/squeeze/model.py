@@ -53,10 +53,11 @@ def _tail_fit(tab, x_min, samples=None, theory=None):
 
     With the tables' tail samples (``info["tail"]``: direct ū and σ̄ below the lowest table
     pressure, up to ~340 h_rms), σ̄^(1/3) = v + d + g(1/v) is fitted to them and to the
-    table top (:func:`fastcontact.tables.tail.fit_tail`); tables without samples get the old two-parameter tail
-    σ̄ = y³ - c y, y = v + d, matched to the top in value and slope (leading order σ̄ = v³ is
-    exact above the roughness; the effective medium's correction -2.2/v² is not of that
-    form, so such tables are accurate to ~1e-5 in σ̄ above the top, not 1e-8)."""
+    table top (:func:`fastcontact.tables.tail.fit_tail`); tables without samples get the old
+    two-parameter tail σ̄ = y³ - c y, y = v + d, matched to the top in value and slope
+    (leading order σ̄ = v³ is exact above the roughness; the effective medium's correction
+    -2.2/v² is not of that form, so such tables are accurate to ~1e-5 in σ̄ above the top,
+    not 1e-8)."""
     ev_u = _ev(qk.lnu_kernel, tab, np.array([x_min, x_min + 1e-4]))
     v_top = math.exp(ev_u[0])
     u0 = -(math.exp(ev_u[1]) - v_top) / 1e-4          # -dv/dln p at the top

@@ -94,8 +94,16 @@ def time_unit_tau(eta, R, h_rms, p0, alpha):
 
     Parameters
     ----------
-    eta : viscosity η [Pa·s];  R : block radius [m];  h_rms : rms roughness [m];
-    p0 : nominal squeezing pressure [Pa];  alpha : h_rms/u0 of law (3) [-].
+    eta : array_like
+        Viscosity η [Pa·s].
+    R : array_like
+        Block radius [m].
+    h_rms : array_like
+        Rms roughness [m].
+    p0 : array_like
+        Nominal squeezing pressure [Pa].
+    alpha : array_like
+        h_rms/u0 of law (3) [-].
     """
     eta = check_positive("eta", eta, "[Pa·s]")
     R = check_positive("R", R, "[m]")
@@ -110,8 +118,12 @@ def kappa_parameter(p0, E_star, beta=1.0):
 
     Parameters
     ----------
-    p0 : nominal squeezing pressure [Pa];  E_star : effective modulus E* [Pa];
-    beta : prefactor β of the asymptotic law (3) [-] (paper's illustration: 1).
+    p0 : array_like
+        Nominal squeezing pressure [Pa].
+    E_star : array_like
+        Effective modulus E* [Pa].
+    beta : array_like
+        Prefactor β of the asymptotic law (3) [-] (paper's illustration: 1).
     """
     p0 = check_positive("p0", p0, "[Pa]")
     E_star = check_positive("E_star", E_star, "[Pa]")
@@ -132,7 +144,12 @@ def contact_pressure_reduced(u, kappa, alpha):
 
     Parameters
     ----------
-    u : separation ū [h_rms], ≥ 0;  kappa : p0/(βE*) [-], > 0;  alpha : h_rms/u0 [-], > 0.
+    u : array_like
+        Separation ū [h_rms], ≥ 0.
+    kappa : array_like
+        p0/(βE*) [-], > 0.
+    alpha : array_like
+        h_rms/u0 [-], > 0.
     """
     u, kappa, alpha = _checked_state(u, kappa, alpha)
     return _scalar_or_array(np.exp(-alpha * u - np.log(kappa)))
@@ -146,7 +163,12 @@ def separation_rate_reduced(u, kappa, alpha):
 
     Parameters
     ----------
-    u : separation ū [h_rms], ≥ 0;  kappa : p0/(βE*) [-], > 0;  alpha : h_rms/u0 [-], > 0.
+    u : array_like
+        Separation ū [h_rms], ≥ 0.
+    kappa : array_like
+        p0/(βE*) [-], > 0.
+    alpha : array_like
+        h_rms/u0 [-], > 0.
     """
     u, kappa, alpha = _checked_state(u, kappa, alpha)
     return _scalar_or_array(u**3 * np.expm1(-alpha * u - np.log(kappa)) / alpha)
@@ -161,7 +183,10 @@ def equilibrium_separation_reduced(kappa, alpha):
 
     Parameters
     ----------
-    kappa : p0/(βE*) [-], in (0, 1);  alpha : h_rms/u0 [-], > 0.
+    kappa : array_like
+        p0/(βE*) [-], in (0, 1).
+    alpha : array_like
+        h_rms/u0 [-], > 0.
     """
     kappa = check_range("kappa", kappa, 0.0, 1.0,
                         "[-] (p0/(beta E*); kappa >= 1 has no positive equilibrium)",
@@ -326,8 +351,16 @@ def flat_separation(u0, t, p0, eta, R):
 
     Parameters
     ----------
-    u0 : initial film thickness ū(0) [m], > 0;  t : time [s], ≥ 0;
-    p0 : nominal squeezing pressure [Pa];  eta : viscosity η [Pa·s];  R : block radius [m].
+    u0 : array_like
+        Initial film thickness ū(0) [m], > 0.
+    t : array_like
+        Time [s], ≥ 0.
+    p0 : array_like
+        Nominal squeezing pressure [Pa].
+    eta : array_like
+        Viscosity η [Pa·s].
+    R : array_like
+        Block radius [m].
     """
     u0 = check_positive("u0", u0, "[m]")
     t = check_positive("t", t, "[s]", allow_zero=True)
@@ -347,8 +380,12 @@ def flat_separation_reduced(u0, t, alpha):
 
     Parameters
     ----------
-    u0 : ū(0) [h_rms], > 0 (+inf allowed: ū = (α/2t)^{1/2});  t : time [τ], ≥ 0;
-    alpha : h_rms/u0 of law (3) [-] (enters through τ).
+    u0 : array_like
+        ū(0) [h_rms], > 0 (+inf allowed: ū = (α/2t)^{1/2}).
+    t : array_like
+        Time [τ], ≥ 0.
+    alpha : array_like
+        h_rms/u0 of law (3) [-] (enters through τ).
     """
     u0 = check_positive("u0", u0, "[h_rms]", allow_inf=True)
     t = check_positive("t", t, "[tau]", allow_zero=True)
@@ -368,7 +405,15 @@ def inertia_time_constant(D, rho, p0):
 
     Parameters
     ----------
-    D : block diameter [m];  rho : fluid density [kg/m³];  p0 : squeezing pressure [Pa].
+    D : array_like
+        Block diameter [m].
+    rho : array_like
+        Fluid density [kg/m³].
+    p0 : array_like
+        Squeezing pressure [Pa].
+
+    Notes
+    -----
     Example: D = 2 cm, ρ = 1000 kg/m³, p0 = 0.3 MPa → τ' = 1.4434e-4 s.
     """
     D = check_positive("D", D, "[m]")
@@ -382,8 +427,19 @@ def inertia_squeeze_time(D, rho, p0, u_start, h_rms):
 
     Parameters
     ----------
-    D : block diameter [m];  rho : fluid density [kg/m³];  p0 : squeezing pressure [Pa];
-    u_start : initial film thickness u(0) [m], > h_rms;  h_rms : rms roughness [m].
+    D : array_like
+        Block diameter [m].
+    rho : array_like
+        Fluid density [kg/m³].
+    p0 : array_like
+        Squeezing pressure [Pa].
+    u_start : array_like
+        Initial film thickness u(0) [m], > h_rms.
+    h_rms : array_like
+        Rms roughness [m].
+
+    Notes
+    -----
     Example: u(0) = 1 cm, h_rms = 0.3 mm, D = 2 cm, p0 = 0.3 MPa → t* ≈ 3.5 τ' ≈ 5e-4 s.
     """
     tau_p = inertia_time_constant(D, rho, p0)
@@ -402,8 +458,16 @@ def inertia_separation(t, u_start, D, rho, p0):
 
     Parameters
     ----------
-    t : time [s], ≥ 0;  u_start : u(0) [m];  D : block diameter [m];
-    rho : fluid density [kg/m³];  p0 : squeezing pressure [Pa].
+    t : array_like
+        Time [s], ≥ 0.
+    u_start : array_like
+        u(0) [m].
+    D : array_like
+        Block diameter [m].
+    rho : array_like
+        Fluid density [kg/m³].
+    p0 : array_like
+        Squeezing pressure [Pa].
     """
     t = check_positive("t", t, "[s]", allow_zero=True)
     u_start = check_positive("u_start", u_start, "[m]")
