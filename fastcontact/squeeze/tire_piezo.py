@@ -21,15 +21,17 @@ B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037.
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 import pandas as pd
 from numba import njit, prange
 
 from ..kernels.quadrature import gauss_legendre
+from ._kernels import Cases, Quad
 from .api import STATUS_NAMES
-from .viscosity import (_lnv_of_lnp, _rate_factor, _scalars, _segment, _start, _state,
-                        _target_times)
+from .viscosity import (BarusTargets, _case_head, _integrand, _lnv_of_lnp, _scalars, _segment,
+                        _start, _state, _target_times)
 
 __all__ = ["QUAD_ORDER", "QUAD_WIDTH", "STATUS", "barus_tire_columns"]
 
@@ -42,33 +44,31 @@ _OK, _TRAPPED, _OUT, _BELOW = (STATUS.index(s) for s in ("ok", "trapped", "out_o
 _PIEZO = STATUS.index("piezo_limit")
 #: the exit search stops this far below ln(ū(0) − ū∞) (ū is then ū∞ to round-off)
 W_SPAN = 60.0
+#: outputs of the Barus tire kernel, one column per row: T (nt, n) target times [s], u_exit,
+#: u_inf, u_start, u_trap [m], flf (fluid load fraction) [-], status (int8)
+TireOut = namedtuple("TireOut", "T u_exit u_inf u_start u_trap flf status")
 
 
 @njit(cache=True)
-def _exit_w(tab, sc, x0, api, vinf, w0, target, glx, glw, width):
+def _exit_w(tab, sc, x0, api, vinf, w0, target, quad):
     """w = ln(v − v∞) reached after reduced time ``target`` from w0 (-inf: beyond W_SPAN)."""
+    width = quad.width
     t = 0.0
     w = w0
     while w > w0 - W_SPAN:
         wn = w - width
-        dt = _segment(tab, sc, x0, api, vinf, wn, w, glx, glw, width)
+        dt = _segment(tab, sc, x0, api, vinf, wn, w, quad)
         if t + dt >= target:
             lo = wn
             hi = w
             y = 0.5 * (lo + hi)
             for _ in range(100):
-                f = t + _segment(tab, sc, x0, api, vinf, y, w, glx, glw, width) - target
+                f = t + _segment(tab, sc, x0, api, vinf, y, w, quad) - target
                 if f > 0.0:
                     lo = y
                 else:
                     hi = y
-                e = math.exp(y)
-                lnp, sig = _state(tab, sc[0], sc[1], sc[2], sc[3], sc[4], vinf + e)
-                dtdw = math.inf
-                if sig > 0.0:
-                    d = max(1e-300, -math.expm1(lnp - x0))
-                    g = _rate_factor(api * d) if api > 0.0 else 1.0
-                    dtdw = e / (sig * d * g)
+                dtdw = _integrand(tab, sc, x0, api, vinf, y)
                 yn = y + f / dtdw if dtdw < math.inf else 0.5 * (lo + hi)
                 if not (lo < yn < hi):
                     yn = 0.5 * (lo + hi)
@@ -82,13 +82,24 @@ def _exit_w(tab, sc, x0, api, vinf, w0, target, glx, glw, width):
 
 
 @njit(parallel=True, cache=True)
-def _tire_kernel(tab, sc, p0, E, R, eta, alpha, us, t_fp, h, vt_ratio, vt_dv, glx, glw, width,
-                 T, u_exit, uinf, ustart, u_trap, flf, status):
-    """Per case: targets (ratios × v∞, then v∞ + dv) and ū at t_fp (SI outputs)."""
+def _tire_kernel(tab, sc, cs, alpha, t_fp, h, tg, quad, out):
+    """Per case (``cs`` :class:`~fastcontact.squeeze._kernels.Cases`, α [1/Pa] and the
+    footprint time t_fp [s] apart): targets (ratios × v∞, then v∞ + dv) and ū at t_fp, SI,
+    into ``out`` (:data:`TireOut`)."""
+    # one output field per statement, outside the loop: a record-field setitem in a prange
+    # body is lost (numba 0.6x parfor lowering; see squeeze._fastpath.fast_kernel)
+    T = out.T
+    u_exit = out.u_exit
+    uinf = out.u_inf
+    ustart = out.u_start
+    u_trap = out.u_trap
+    flf = out.flf
+    status = out.status
+    us = cs.us
+    p0 = cs.p0
     nt = T.shape[0]
     for i in prange(p0.size):
-        x0 = math.log(p0[i] / E[i])
-        tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
+        x0, tau, inside = _case_head(cs, sc, h, i)
         for k in range(nt):
             T[k, i] = math.nan
         u_exit[i] = math.nan
@@ -96,17 +107,18 @@ def _tire_kernel(tab, sc, p0, E, R, eta, alpha, us, t_fp, h, vt_ratio, vt_dv, gl
         flf[i] = math.nan
         uinf[i] = math.nan
         ustart[i] = us[i]
-        if not (sc[0] <= x0 <= sc[5]):
+        if not inside:
             status[i] = _OUT
             continue
         vinf, vs = _start(tab, sc, x0, us[i], h)
         uinf[i] = vinf * h
         ustart[i] = vs * h
-        trapped = x0 >= sc[4]
+        x_trap = sc[0].x_trap
+        trapped = x0 >= x_trap
         if trapped:
             status[i] = _TRAPPED
-            u_trap[i] = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], sc[4])) * h
-            flf[i] = -math.expm1(sc[4] - x0)
+            u_trap[i] = math.exp(_lnv_of_lnp(tab, sc, x_trap)) * h
+            flf[i] = -math.expm1(x_trap - x0)
         else:
             status[i] = _OK
             flf[i] = 0.0
@@ -114,15 +126,15 @@ def _tire_kernel(tab, sc, p0, E, R, eta, alpha, us, t_fp, h, vt_ratio, vt_dv, gl
             status[i] = _BELOW
             continue
         api = alpha[i] * p0[i]
-        lnps, _s = _state(tab, sc[0], sc[1], sc[2], sc[3], sc[4], vs)
+        lnps, _s = _state(tab, sc, vs)
         if api * (-math.expm1(lnps - x0)) >= 1.0:
             status[i] = _PIEZO
             flf[i] = math.nan
             u_trap[i] = math.nan
             continue
-        _target_times(tab, sc, x0, api, vinf, vs, vt_ratio, vt_dv, tau, glx, glw, width, T, i)
+        _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
         w0 = math.log(vs - vinf)
-        w = _exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, glx, glw, width)
+        w = _exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, quad)
         u_exit[i] = (vinf + math.exp(w)) * h
 
 
@@ -148,11 +160,12 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
     if m:
         us_in = b["u_start"][sel] if "u_start" in b else np.full(m, np.nan)
         x, w = gauss_legendre(QUAD_ORDER)
-        args = [np.ascontiguousarray(a, dtype=np.float64) for a in
-                (p_eval[sel], b["E_star"][sel], b["R"][sel], b["eta"][sel], alpha[sel], us_in,
-                 t_fp[sel])]
-        _tire_kernel(tables.kernel_data(theory), _scalars(tables, theory, None), *args, h, vr,
-                     dv, x, w, QUAD_WIDTH, T, ue, ui, us, ut, fl, st)
+        p, E, R, eta, al, u0, tf = [np.ascontiguousarray(a, dtype=np.float64) for a in
+                                    (p_eval[sel], b["E_star"][sel], b["R"][sel], b["eta"][sel],
+                                     alpha[sel], us_in, t_fp[sel])]
+        _tire_kernel(tables.kernel_data(theory), _scalars(tables, theory, None),
+                     Cases(p, E, R, eta, u0), al, tf, h, BarusTargets(vr, dv),
+                     Quad(x, w, QUAD_WIDTH), TireOut(T, ue, ui, us, ut, fl, st))
     with np.errstate(invalid="ignore"):
         piezo = {"u_inf": ui, "u_start": us, "t_du": T[1 + r.size], "t_star": T[0],
                  "trapped": st == _TRAPPED, "u_trap": ut, "fluid_load_fraction": fl,

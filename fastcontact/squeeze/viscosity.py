@@ -24,6 +24,7 @@ B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037.
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 import pandas as pd
@@ -34,6 +35,8 @@ from .._core.vocab import DEFAULT_THEORY, column_name
 from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
 from .api import register_extension, squeeze_out
 from ..kernels.quadrature import gauss_legendre
+from ..kernels.records import scalar_record
+from ._kernels import Cases, Quad
 
 __all__ = [
     "DEFAULT_P_START",
@@ -45,6 +48,12 @@ __all__ = [
 #: default start, as in :func:`fastcontact.squeeze.squeeze_out`: p_cont(u_start) = 1e-3 p0
 DEFAULT_P_START = 1e-3
 ST_OK, ST_TRAPPED, ST_OUT, ST_PIEZO = 0, 1, 2, 3
+#: targets shared by all cases: ratios ū/ū∞ (t_star's 1.01 first, then the ratio targets) [-]
+#: and dvs = Δu/h_rms of the Δu targets [-]
+BarusTargets = namedtuple("BarusTargets", "ratios dvs")
+#: outputs of :func:`squeeze_out_piezo`, one column per case: T (nt, n) target times [s],
+#: u_inf, u_start [m], tau0 [s], g_start (rate factor at the start) [-], status (int8)
+BarusOut = namedtuple("BarusOut", "T u_inf u_start tau0 g_start status")
 
 
 # =========================================================================== closed forms
@@ -120,21 +129,23 @@ def barus_rate_factor(a):
 
 # =========================================================================== kernels
 @njit(cache=True)
-def _state(tab, x_min, v_top, u0, lnsig_top, x_trap, v):
+def _state(tab, sc, v):
     """(ln π_c, σ̄) at v = ū/h_rms; above the table top: eq. (3) tail and σ̄ ∝ v³."""
-    if v > v_top:
-        return x_min - (v - v_top) / u0, math.exp(lnsig_top) * (v / v_top) ** 3
+    s = sc[0]
+    if v > s.v_top:
+        return s.x_min - (v - s.v_top) / s.u0, math.exp(s.lnsig_top) * (v / s.v_top) ** 3
     lnp = k_lnp_of_lnu(tab, math.log(v))
-    if lnp >= x_trap:
+    if lnp >= s.x_trap:
         return lnp, 0.0
     return lnp, k_sigma_of_lnp(tab, lnp)
 
 
 @njit(cache=True)
-def _lnv_of_lnp(tab, x_min, v_top, u0, x):
+def _lnv_of_lnp(tab, sc, x):
     """ln v with π_c(v) = e^x for the inverse interpolant (Newton on k_lnp_of_lnu)."""
-    if x <= x_min:
-        return math.log(v_top + u0 * (x_min - x))
+    s = sc[0]
+    if x <= s.x_min:
+        return math.log(s.v_top + s.u0 * (s.x_min - x))
     y = k_lnu_of_lnp(tab, x)
     hh = 1e-6
     for _ in range(6):
@@ -157,10 +168,10 @@ def _lnv_of_lnp(tab, x_min, v_top, u0, x):
 def _start(tab, sc, x0, u_start, h):
     """(v∞, v_start) = (ū∞, ū_start)/h_rms at ln(p0/E*) = x0; u_start [m] NaN: the default
     start, where p_cont = DEFAULT_P_START·p0."""
-    vinf = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0))
+    vinf = math.exp(_lnv_of_lnp(tab, sc, x0))
     vs = u_start / h
     if vs != vs:
-        vs = math.exp(_lnv_of_lnp(tab, sc[0], sc[1], sc[2], x0 + math.log(DEFAULT_P_START)))
+        vs = math.exp(_lnv_of_lnp(tab, sc, x0 + math.log(DEFAULT_P_START)))
     return vinf, vs
 
 
@@ -168,7 +179,7 @@ def _start(tab, sc, x0, u_start, h):
 def _integrand(tab, sc, x0, api, vinf, w):
     """dt̃/dw at w = ln(v - v∞): (v - v∞)/(σ̄ d g(api d)), d = 1 - π_c/π0; 0 if σ̄ = 0."""
     e = math.exp(w)
-    lnp, sig = _state(tab, sc[0], sc[1], sc[2], sc[3], sc[4], vinf + e)
+    lnp, sig = _state(tab, sc, vinf + e)
     if not (sig > 0.0):
         return math.inf
     d = -math.expm1(lnp - x0)
@@ -178,7 +189,9 @@ def _integrand(tab, sc, x0, api, vinf, w):
 
 
 @njit(cache=True)
-def _segment(tab, sc, x0, api, vinf, w1, w2, glx, glw, width):
+def _segment(tab, sc, x0, api, vinf, w1, w2, quad):
+    """∫_{w1}^{w2} dt̃/dw dw, composite Gauss–Legendre (``quad``), panels of width <= width."""
+    glx, glw, width = quad.glx, quad.glw, quad.width
     if not (w2 > w1):
         return 0.0
     m = max(1, int(math.ceil((w2 - w1) / width)))
@@ -192,9 +205,12 @@ def _segment(tab, sc, x0, api, vinf, w1, w2, glx, glw, width):
 
 
 @njit(cache=True)
-def _target_times(tab, sc, x0, api, vinf, vs, vt_ratio, vt_dv, tau, glx, glw, width, T, i):
-    """Times [s] from v_start down to each target (ratios ū/ū∞, then Δu/h_rms) into column i
-    of T: one downward pass over the targets in descending order; 0 for targets passed."""
+def _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i):
+    """Times [s] from v_start down to each target of ``tg`` (:data:`BarusTargets`) into
+    column i of T: one downward pass over the targets in descending order; 0 for targets
+    passed."""
+    vt_ratio = tg.ratios
+    vt_dv = tg.dvs
     nt = T.shape[0]
     nr = vt_ratio.size
     vts = np.empty(nt)
@@ -211,21 +227,39 @@ def _target_times(tab, sc, x0, api, vinf, vs, vt_ratio, vt_dv, tau, glx, glw, wi
             continue
         if vt < v_cur:
             t_cur += _segment(tab, sc, x0, api, vinf, math.log(vt - vinf),
-                              math.log(v_cur - vinf), glx, glw, width)
+                              math.log(v_cur - vinf), quad)
             v_cur = vt
         T[k, i] = tau * t_cur
 
 
+@njit(cache=True, inline="always")
+def _case_head(cs, sc, h, i):
+    """(x0 = ln(p0/E*), τ0 = 3ηR²/(2 h_rms² p0) [s], x0 within the tables) of case i."""
+    x0 = math.log(cs.p0[i] / cs.E[i])
+    tau = 3.0 * cs.eta[i] * cs.R[i] * cs.R[i] / (2.0 * h * h * cs.p0[i])
+    return x0, tau, sc[0].x_min <= x0 <= sc[0].x_max
+
+
 @njit(parallel=True, cache=True)
-def _piezo_kernel(tab, sc, p0, E, R, eta, alpha, us, h, vt_ratio, vt_dv, glx, glw, width,
-                  T, uinf, ustart, tau0, gstart, status):
-    """Per case: targets (ratios × v∞, then v∞ + dv) sorted downward, one pass (t̃ → SI)."""
+def _piezo_kernel(tab, sc, cs, alpha, h, tg, quad, out):
+    """Per case (``cs`` :class:`~fastcontact.squeeze._kernels.Cases`, α [1/Pa] apart): targets
+    (ratios × v∞, then v∞ + dv) sorted downward, one pass (t̃ → SI) into ``out``
+    (:data:`BarusOut`)."""
+    # one output field per statement, outside the loop: a record-field setitem in a prange
+    # body is lost (numba 0.6x parfor lowering; see squeeze._fastpath.fast_kernel)
+    T = out.T
+    uinf = out.u_inf
+    ustart = out.u_start
+    tau0 = out.tau0
+    gstart = out.g_start
+    status = out.status
+    us = cs.us
+    p0 = cs.p0
     nt = T.shape[0]
     for i in prange(p0.size):
-        x0 = math.log(p0[i] / E[i])
-        tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
+        x0, tau, inside = _case_head(cs, sc, h, i)
         tau0[i] = tau
-        if not (sc[0] <= x0 <= sc[5]):
+        if not inside:
             status[i] = ST_OUT
             uinf[i] = math.nan
             ustart[i] = us[i]
@@ -237,16 +271,16 @@ def _piezo_kernel(tab, sc, p0, E, R, eta, alpha, us, h, vt_ratio, vt_dv, glx, gl
         uinf[i] = vinf * h
         ustart[i] = vs * h
         api = alpha[i] * p0[i]
-        lnps, _s = _state(tab, sc[0], sc[1], sc[2], sc[3], sc[4], vs)
+        lnps, _s = _state(tab, sc, vs)
         d_start = -math.expm1(lnps - x0)
         gstart[i] = _rate_factor(api * d_start) if api > 0.0 else 1.0
-        status[i] = ST_TRAPPED if x0 >= sc[4] else ST_OK
+        status[i] = ST_TRAPPED if x0 >= sc[0].x_trap else ST_OK
         if api * d_start >= 1.0:
             status[i] = ST_PIEZO
             for k in range(nt):
                 T[k, i] = math.nan
             continue
-        _target_times(tab, sc, x0, api, vinf, vs, vt_ratio, vt_dv, tau, glx, glw, width, T, i)
+        _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
 
 
 # =========================================================================== model
@@ -254,7 +288,13 @@ _SC_CACHE = {}
 
 
 def _scalars(tables, theory, sigma_trap):
-    """(x_min, v_top, u0, ln σ̄_top, x_trap, x_max) of (tables, theory) — the tail and trap."""
+    """The scalar record of (tables, theory): the table range, the tail above its top and the
+    trap (one record, so that the kernels read the six by name).
+
+    Fields: x_min, x_max = ln π of the tables' ends [-]; v_top = ū/h_rms at the table top [-];
+    u0 = -dv/d ln π there (eq. (3) tail) [-]; lnsig_top = ln σ̄ at the top [-]; x_trap = ln π
+    above which σ̄ is below the trap floor (inf: never) [-].
+    """
     key = (id(tables), tables.surface.fingerprint(), theory, sigma_trap)
     if key in _SC_CACHE:
         return _SC_CACHE[key]
@@ -280,7 +320,8 @@ def _scalars(tables, theory, sigma_trap):
             x_trap = hi
         elif math.log(perc) <= x_max:
             x_trap = math.log(perc)
-    sc = np.array([x_min, v[0], u0, math.log(sig_top), x_trap, x_max])
+    sc = scalar_record({"x_min": x_min, "v_top": v[0], "u0": u0, "lnsig_top": math.log(sig_top),
+                        "x_trap": x_trap, "x_max": x_max})
     _SC_CACHE[key] = sc
     return sc
 
@@ -348,8 +389,9 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     uinf, ustart, tau0, gs = (np.empty(n) for _ in range(4))
     status = np.empty(n, dtype=np.int8)
     x, w = gauss_legendre(qo)
-    _piezo_kernel(tables.kernel_data(theory), sc, *flat, h, vr, dv, x, w, width, T, uinf,
-                  ustart, tau0, gs, status)
+    cs = Cases(flat[0], flat[1], flat[2], flat[3], flat[5])
+    _piezo_kernel(tables.kernel_data(theory), sc, cs, flat[4], h, BarusTargets(vr, dv),
+                  Quad(x, w, width), BarusOut(T, uinf, ustart, tau0, gs, status))
     if u_start is not None:
         bad = (status == ST_OK) & ~(flat[5] > uinf)
         if np.any(bad):
