@@ -39,7 +39,9 @@ import pandas as pd
 from .._core.validate import check_positive
 from ..flow.piezoviscosity import ROELANDS_ETA_INF, check_law, roelands_parameters
 from ..kernels.quadrature import gauss_legendre
-from ._piezo_kernels import TAIL_CUT, _hertz_kernel, _hertz_kernel_r, _uniform_kernel
+from ..kernels.records import scalar_record
+from ._piezo_kernels import (TAIL_CUT, HertzRows, Quad, UniformRows, _hertz_kernel,
+                             _hertz_kernel_r, _uniform_kernel)
 
 __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
 
@@ -50,14 +52,19 @@ HERTZ_STEPS = 200
 
 # =========================================================================== API
 def _scalars(tables, theory):
-    """(x_min, v_top, u0, ln σ̄_top, x_max, x_perc) of (tables, theory)."""
+    """The record of (tables, theory) the kernels read (a record: it reaches prange bodies).
+
+    Fields: ``x_lo`` = ln p̄ at the table bottom, ``u_lo`` = ū/h_rms there, ``du_lo`` =
+    -dū/d ln p̄ /h_rms there, ``lnsig_lo`` = ln σ̄ there, ``x_hi`` = ln p̄ at the table top,
+    ``x_perc`` = ln p̄ at percolation (inf: none)."""
     p_lo, p_hi = tables.p_range
     d = 1e-4
     v = tables.mean_separation(np.array([p_lo, p_lo * math.exp(d)]), 1.0) / tables.h_rms
     perc = tables.info["percolation_p_over_E"][theory]
-    return np.array([math.log(p_lo), v[0], (v[0] - v[1]) / d,
-                     math.log(float(tables.sigma_bar(p_lo, 1.0, theory))), math.log(p_hi),
-                     math.log(perc) if np.isfinite(perc) else math.inf])
+    return scalar_record({"x_lo": math.log(p_lo), "u_lo": v[0], "du_lo": (v[0] - v[1]) / d,
+                          "lnsig_lo": math.log(float(tables.sigma_bar(p_lo, 1.0, theory))),
+                          "x_hi": math.log(p_hi),
+                          "x_perc": math.log(perc) if np.isfinite(perc) else math.inf})
 
 
 def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_junction",
@@ -195,8 +202,8 @@ def _uniform_rows(tab, sc, v, law, quad_order, quad_width):
     12 η0 q / h³ [Pa/m] by the uniform-ring integral of every running row."""
     E, pa, pb, p0v, Lv = v["E"], v["pa"], v["p_b"], v["g1"], v["g2"]
     lift = pa > p0v
-    perc = (p0v - pb >= math.exp(sc[5]) * E) & ~lift
-    out_t = (p0v - pb > math.exp(sc[4]) * E) & ~perc & ~lift
+    perc = (p0v - pb >= math.exp(sc[0]["x_perc"]) * E) & ~lift
+    out_t = (p0v - pb > math.exp(sc[0]["x_hi"]) * E) & ~perc & ~lift
     kq = np.zeros(E.size)
     run = ~lift & ~perc & ~out_t & (v["dp"] > 0)
     if np.any(run):
@@ -204,7 +211,8 @@ def _uniform_rows(tab, sc, v, law, quad_order, quad_width):
         out = np.empty(int(run.sum()))
         A, Z, pr = law if law is not None else (v["alpha_pv"], np.zeros(E.size), 0.0)
         sub = [np.ascontiguousarray(a[run], dtype=np.float64) for a in (p0v, Lv, pa, pb, E, A, Z)]
-        _uniform_kernel(tab, sc, *sub, float(pr), x, w, float(quad_width), out)
+        _uniform_kernel(tab, sc, UniformRows(*sub), float(pr), Quad(x, w, float(quad_width)),
+                        out)
         kq[run] = out
     cols = _base_columns(v)
     cols.update({"p0": p0v, "L": Lv, "open_inlet": np.where(pa > p0v, Lv, 0.0),
@@ -218,8 +226,8 @@ def _hertz_rows(tab, sc, v, law, steps):
     a = np.sqrt(4.0 * v["g2"] * v["g1"] / (math.pi * E))
     pH = 2.0 * v["g2"] / (math.pi * a)
     lift = pa > pH
-    perc = (pH - pa >= math.exp(sc[5]) * E) & ~lift
-    out_t = (pH - pb > math.exp(sc[4]) * E) & ~perc & ~lift
+    perc = (pH - pa >= math.exp(sc[0]["x_perc"]) * E) & ~lift
+    out_t = (pH - pb > math.exp(sc[0]["x_hi"]) * E) & ~perc & ~lift
     kq = np.zeros(E.size)
     conv = np.ones(E.size, dtype=bool)
     run = ~lift & ~perc & ~out_t & (v["dp"] > 0)
@@ -228,7 +236,7 @@ def _hertz_rows(tab, sc, v, law, steps):
         ok = np.empty(int(run.sum()), dtype=np.bool_)
         if law is not None:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, law[0], law[1])]
-            _hertz_kernel_r(tab, sc, *sub, law[2], int(steps), k, ok)
+            _hertz_kernel_r(tab, sc, HertzRows(*sub), law[2], int(steps), k, ok)
         else:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, v["alpha_pv"])]
             _hertz_kernel(tab, sc, *sub, int(steps), k, ok)
