@@ -274,10 +274,12 @@ def remaining_fraction(t, pan, P, n, coef, after, W, Pk):
 
 
 @njit(cache=True)
-def remaining_at(kind, gp, xo, x0, ell, m, pan, P, n, r, W, Lp, frac):
+def remaining_at(kind, gp, xo, x0, ell, rule, pan, P, r, W, frac):
     """Fraction of the pressure drop still ahead, (p_f − p_b)/Δp, at the positions xo [m].
 
-    ell is the length unit of ξ (a for Hertz, L for arrays) and x0 the inlet position."""
+    ell is the length unit of ξ (a for Hertz, L for arrays) and x0 the inlet position; the
+    solution r on the mesh pan (P panels) of the panel rule ``rule`` (its m, n and Lp)."""
+    m, n, Lp = rule.m, rule.n, rule.Lp
     coef = np.empty((P, n))
     after = np.empty(P)
     Pk = np.empty(n + 1)

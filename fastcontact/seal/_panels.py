@@ -16,6 +16,7 @@ Next to percolation a failed Newton is continued in p_a from an easier problem
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -25,14 +26,76 @@ from ._mesh import (array_zone, geometry, interp_series, panel_series, remaining
 from ._sigma import sig_d
 
 __all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "ST_OK", "ST_NOT_REFINED",
-           "ST_NEWTON_FAILED", "ST_NO_ZONE"]
+           "ST_NEWTON_FAILED", "ST_NO_ZONE", "Zone", "State", "Work", "Mesh"]
 
 #: status codes of solve_case
 ST_OK, ST_NOT_REFINED, ST_NEWTON_FAILED, ST_NO_ZONE = 0, 1, 2, 3
 
 
+class Zone(NamedTuple):
+    """The sealing zone of one case (one argument instead of six): profile kind (0 Hertz,
+    1 array), zone parameters gp (:func:`._mesh.zone_params`), the array profile's samples
+    xg, pg, and the reduced pressures π_a, π_b at the ends."""
+
+    kind: int
+    gp: np.ndarray
+    xg: np.ndarray
+    pg: np.ndarray
+    pia: float
+    pib: float
+
+
+class State(NamedTuple):
+    """One Newton state at the nodes: contact pressure c, resistance density r = dξ/dt / σ̄(c),
+    D = dr/dc, tail integrals R̃ and residuals F."""
+
+    c: np.ndarray
+    r: np.ndarray
+    D: np.ndarray
+    Rt: np.ndarray
+    F: np.ndarray
+
+
+class Work(NamedTuple):
+    """Work arrays of one soft-seal solve, allocated once per case (one argument instead of
+    two dozen): node positions t, ξ, dξ/dt, e_a, e_b; Newton's current and trial states
+    (:class:`State`); the right-hand sides y1, y2 and the panel blocks Y (n×2), K (n×n); the
+    mesh pan and its refinement pan2, panel errors err; the Legendre series coef, after, Pk."""
+
+    t: np.ndarray
+    xi: np.ndarray
+    dxi: np.ndarray
+    ea: np.ndarray
+    eb: np.ndarray
+    s0: State
+    s1: State
+    y1: np.ndarray
+    y2: np.ndarray
+    Y: np.ndarray
+    K: np.ndarray
+    pan: np.ndarray
+    pan2: np.ndarray
+    err: np.ndarray
+    coef: np.ndarray
+    after: np.ndarray
+    Pk: np.ndarray
+
+
+class Mesh(NamedTuple):
+    """A solution on its mesh: panel edges pan (PMAX+1), nodal contact pressure c and
+    resistance density r (PMAX·n)."""
+
+    pan: np.ndarray
+    c: np.ndarray
+    r: np.ndarray
+
+
 @njit(cache=True)
-def _fill_nodes(kind, gp, xg, pg, m, pia, pib, zl, pan, P, n, t, xi, dxi, ea, eb):
+def _fill_nodes(zone, rule, wk, P):
+    """Nodes t, ξ, dξ/dt, e_a, e_b of the P panels of wk.pan."""
+    kind, gp, xg, pg, pia, pib = zone
+    m, n, zl, pan = rule.m, rule.n, rule.zl, wk.pan
+    t, xi, dxi, ea, eb = wk.t, wk.xi, wk.dxi, wk.ea, wk.eb
     for p in range(P):
         tl = pan[p]
         tr = pan[p + 1]
@@ -44,10 +107,14 @@ def _fill_nodes(kind, gp, xg, pg, m, pia, pib, zl, pan, P, n, t, xi, dxi, ea, eb
 
 
 @njit(cache=True)
-def _resid(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, r, D, Rt, F):
-    """r = dξ/dt / σ̄(c), D = dr/dc, R̃ and F at c; returns (W, max|F|, ok).
+def _resid(tab, sc, rule, wk, st, dpi, P):
+    """r = dξ/dt / σ̄(c), D = dr/dc, R̃ and F at c (the :class:`State` st) on the mesh wk.pan;
+    returns (W, max|F|, ok).
 
     ok is False if σ̄ = 0 somewhere (c at/after percolation: infinite resistance)."""
+    n, wl, At = rule.n, rule.wl, rule.At
+    dxi, eb, pan = wk.dxi, wk.eb, wk.pan
+    c, r, D, Rt, F = st
     N = P * n
     for i in range(N):
         ci = c[i]
@@ -84,14 +151,16 @@ def _resid(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, r, D, Rt, F):
 
 
 @njit(cache=True)
-def _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, ftol,
-            r, D, Rt, F, c2, r2, D2, Rt2, F2, y1, y2, Y, K):
-    """Damped Newton on the current mesh; c and r hold the result. Returns (W, its, ok)."""
+def _newton(tab, sc, rule, wk, dpi, P, maxit, ftol):
+    """Damped Newton on the current mesh wk.pan from wk.s0; wk.s0.c and wk.s0.r hold the
+    result. Returns (W, its, ok)."""
+    n, wl, At = rule.n, rule.wl, rule.At
+    pan, y1, y2, Y, K = wk.pan, wk.y1, wk.y2, wk.Y, wk.K
     N = P * n
-    W, fmax, ok = _resid(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, r, D, Rt, F)
+    W, fmax, ok = _resid(tab, sc, rule, wk, wk.s0, dpi, P)
     if not ok:
         return W, 0, False
-    cur = 0          # 0: current state in (c, r, D, Rt, F); 1: in the *2 arrays
+    cur = 0          # 0: current state in wk.s0; 1: in wk.s1
     its = 0
     conv = False
     while its < maxit:
@@ -99,8 +168,9 @@ def _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, ftol,
             conv = True
             break
         its += 1
-        cc, rr, DD, RR, FF = (c, r, D, Rt, F) if cur == 0 else (c2, r2, D2, Rt2, F2)
-        ct, rt, Dt, Rtt, Ft = (c2, r2, D2, Rt2, F2) if cur == 0 else (c, r, D, Rt, F)
+        now, trial = (wk.s0, wk.s1) if cur == 0 else (wk.s1, wk.s0)
+        cc, DD, RR, FF = now.c, now.D, now.Rt, now.F
+        ct = trial.c
         # B̃ y = b for b1 = -F and b2 = u = dπ R̃/W²: block back-substitution from the outlet
         g = dpi / W
         S1 = 0.0
@@ -116,11 +186,11 @@ def _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, ftol,
             if not solve_small(K, Y, n, 2):
                 return W, its, False
             for k in range(n):
-                wk = hh * wl[k] * DD[p * n + k]
+                wk_ = hh * wl[k] * DD[p * n + k]
                 y1[p * n + k] = Y[k, 0]
                 y2[p * n + k] = Y[k, 1]
-                S1 += wk * Y[k, 0]
-                S2 += wk * Y[k, 1]
+                S1 += wk_ * Y[k, 0]
+                S2 += wk_ * Y[k, 1]
         # Sherman–Morrison: δ = y1 − y2 (vᵀy1)/(1 + vᵀy2), v = w∘D
         den = 1.0 + S2
         if den == 0.0:
@@ -136,7 +206,7 @@ def _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, ftol,
         for ls in range(24):
             for i in range(N):
                 ct[i] = cc[i] + lam * y1[i]
-            Wt, ft, okt = _resid(tab, sc, ct, dxi, eb, dpi, pan, P, n, wl, At, rt, Dt, Rtt, Ft)
+            Wt, ft, okt = _resid(tab, sc, rule, wk, trial, dpi, P)
             if okt and ft <= (1.0 - 1e-4 * lam) * fmax:
                 accepted = True
                 break
@@ -151,6 +221,7 @@ def _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, ftol,
             conv = True
             break
     if cur == 1:
+        c, r, c2, r2 = wk.s0.c, wk.s0.r, wk.s1.c, wk.s1.r
         for i in range(N):
             c[i] = c2[i]
             r[i] = r2[i]
@@ -158,19 +229,28 @@ def _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, ftol,
 
 
 @njit(cache=True)
-def _node_arrays(N):
-    """Work arrays of a mesh of N nodes: t, ξ, dξ/dt, e_a, e_b, then (c, r, D, R̃, F) twice
-    (Newton's current and trial states) and the two right-hand sides y1, y2."""
-    return (np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N),
-            np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N),
-            np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N))
+def _state(N):
+    return State(np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N))
 
 
 @njit(cache=True)
-def _first_guess(kind, gp, xg, pg, m, pia, pib, dpi, xi, eb, N, cperc, init_P, init_s, c):
-    """Initial contact pressure c at the N nodes: c = e_b − Δπ s with s = init_s
-    (continuation, init_P > 0) or the fluid pressure linear in ξ across the zone, capped
-    below percolation. Returns the Newton tolerance on F (1e-13 of the pressure scale)."""
+def _work(n, PMAX):
+    """The :class:`Work` of a mesh of up to PMAX panels of n nodes."""
+    N = PMAX * n
+    return Work(np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N), _state(N),
+                _state(N), np.empty(N), np.empty(N), np.empty((n, 2)), np.empty((n, n)),
+                np.empty(PMAX + 1), np.empty(PMAX + 1), np.empty(PMAX), np.empty((PMAX, n)),
+                np.empty(PMAX), np.empty(n + 1))
+
+
+@njit(cache=True)
+def _first_guess(zone, m, wk, N, cperc, init_P, init_s):
+    """Initial contact pressure c (into wk.s0.c) at the N nodes: c = e_b − Δπ s with
+    s = init_s (continuation, init_P > 0) or the fluid pressure linear in ξ across the zone,
+    capped below percolation. Returns the Newton tolerance on F (1e-13 of the pressure scale)."""
+    kind, gp, xg, pg, pia, pib = zone
+    xi, eb, c = wk.xi, wk.eb, wk.s0.c
+    dpi = pia - pib
     scale = dpi
     for i in range(N):
         scale = max(scale, abs(eb[i]))
@@ -205,9 +285,10 @@ def _indicator(r, pan, P, n, Lp, coef, after, W, tol, err):
 
 
 @njit(cache=True)
-def _series_at_nodes(pan_new, P_new, zl, n, pan, P, coef, after, W, Pk, remaining, out):
+def _series_at_nodes(pan_new, P_new, rule, pan, P, coef, after, W, Pk, remaining, out):
     """At the Gauss–Legendre nodes of the mesh pan_new (P_new panels), the converged
     solution's remaining fraction s(t) (``remaining``) or its series of r (coef) into out."""
+    zl, n = rule.zl, rule.n
     for p in range(P_new):
         tl = pan_new[p]
         tr = pan_new[p + 1]
@@ -234,44 +315,35 @@ def _halve(pan, P, err, tol, pan2):
 
 
 @njit(cache=True)
-def solve_case(tab, sc, rule, tol, maxit, kind, gp, xg, pg, pia, pib, pan_out, c_out, r_out,
-               init_P, init_pan, init_s, s_out):
-    """Solve one soft seal on its sealing zone (see the module docstring).
+def solve_case(tab, sc, rule, tol, maxit, zone, out, init_P, init_pan, init_s, s_out):
+    """Solve one soft seal on its sealing zone (:class:`Zone`; see the module docstring).
 
     Returns (W, status, panels, error_estimate, newton_iterations), W = ∫ dξ/σ̄ over the
-    zone. pan_out (PMAX+1), c_out and r_out (PMAX·n) receive the final mesh and the nodal
-    contact pressure and resistance density; s_out (optional) the remaining fraction of the
-    pressure drop (p_f − p_b)/Δp at the nodes. With init_P > 0 the first mesh is init_pan and
-    the initial guess c = (p0 − p_b) − Δp·init_s at its nodes (continuation); otherwise P0
+    zone. ``out`` (:class:`Mesh`: pan PMAX+1, c and r PMAX·n) receives the final mesh and the
+    nodal contact pressure and resistance density; s_out (optional) the remaining fraction of
+    the pressure drop (p_f − p_b)/Δp at the nodes. With init_P > 0 the first mesh is init_pan
+    and the initial guess c = (p0 − p_b) − Δp·init_s at its nodes (continuation); otherwise P0
     uniform panels and a fluid pressure linear in x. s_out is filled if it is large enough
     (pass an empty array to skip).
     """
-    m, n, P0, PMAX = rule.m, rule.n, rule.P0, rule.PMAX
-    zl, wl, At, Lp = rule.zl, rule.wl, rule.At, rule.Lp
-    dpi = pia - pib
-    t, xi, dxi, ea, eb, c, r, D, Rt, F, c2, r2, D2, Rt2, F2, y1, y2 = _node_arrays(PMAX * n)
-    Y = np.empty((n, 2))
-    K = np.empty((n, n))
-    Pk = np.empty(n + 1)
-    coef = np.empty((PMAX, n))
-    after = np.empty(PMAX)
-    pan = np.empty(PMAX + 1)
-    pan2 = np.empty(PMAX + 1)
-    err = np.empty(PMAX)
+    n, P0, PMAX = rule.n, rule.P0, rule.PMAX
+    Lp = rule.Lp
+    dpi = zone.pia - zone.pib
+    wk = _work(n, PMAX)
+    pan, pan2, err, coef, after, Pk = wk.pan, wk.pan2, wk.err, wk.coef, wk.after, wk.Pk
+    c, r, eb, y1 = wk.s0.c, wk.s0.r, wk.eb, wk.y1
     P = init_P if init_P > 0 else P0
     for p in range(P + 1):
         pan[p] = init_pan[p] if init_P > 0 else p / P
-    _fill_nodes(kind, gp, xg, pg, m, pia, pib, zl, pan, P, n, t, xi, dxi, ea, eb)
-    ftol = _first_guess(kind, gp, xg, pg, m, pia, pib, dpi, xi, eb, P * n, sc.p_perc, init_P,
-                        init_s, c)
+    _fill_nodes(zone, rule, wk, P)
+    ftol = _first_guess(zone, rule.m, wk, P * n, sc.p_perc, init_P, init_s)
     status = ST_OK
     total_it = 0
     est = math.inf
     W = 0.0
     for rnd in range(4 * PMAX):
         # intermediate meshes: converge loosely (the indicator needs r to ~1e-9 only)
-        W, its, conv = _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, 1e4 * ftol,
-                               r, D, Rt, F, c2, r2, D2, Rt2, F2, y1, y2, Y, K)
+        W, its, conv = _newton(tab, sc, rule, wk, dpi, P, maxit, 1e4 * ftol)
         total_it += its
         if not conv:
             status = ST_NEWTON_FAILED
@@ -281,22 +353,21 @@ def solve_case(tab, sc, rule, tol, maxit, kind, gp, xg, pg, pia, pib, pan_out, c
             if nsplit > 0:
                 status = ST_NOT_REFINED
             # final mesh: polish to round-off
-            W, its, conv = _newton(tab, sc, c, dxi, eb, dpi, pan, P, n, wl, At, maxit, ftol,
-                                   r, D, Rt, F, c2, r2, D2, Rt2, F2, y1, y2, Y, K)
+            W, its, conv = _newton(tab, sc, rule, wk, dpi, P, maxit, ftol)
             total_it += its
             if not conv:
                 status = ST_NEWTON_FAILED
             break
         Pn = _halve(pan, P, err, tol, pan2)
         # new nodes: remaining fraction s(t) of the converged solution, then c = e_b − Δπ s
-        _series_at_nodes(pan2, Pn, zl, n, pan, P, coef, after, W, Pk, True, y1)
+        _series_at_nodes(pan2, Pn, rule, pan, P, coef, after, W, Pk, True, y1)
         for p in range(Pn + 1):
             pan[p] = pan2[p]
         P = Pn
-        _fill_nodes(kind, gp, xg, pg, m, pia, pib, zl, pan, P, n, t, xi, dxi, ea, eb)
+        _fill_nodes(zone, rule, wk, P)
         for i in range(P * n):
             c[i] = eb[i] - dpi * y1[i]
-    _copy_mesh(P, n, pan, c, r, pan_out, c_out, r_out)
+    _copy_mesh(P, n, pan, c, r, out.pan, out.c, out.r)
     if s_out.size >= P * n:
         for i in range(P * n):
             s_out[i] = (eb[i] - c[i]) / dpi
@@ -328,12 +399,14 @@ def _continuation(cperc, pmax, pia, pib):
 
 
 @njit(cache=True)
-def _refine_previous(r_prev, pan, P, n, Lp, zl, PMAX, W_prev, coef, after, Pk, pan_new, s_new,
-                     rr):
+def _refine_previous(rule, r_prev, pan, P, W_prev, coef, after, Pk, new):
     """After a failed continuation step: halve the previous solution's panels where its
     resistance concentrates (the peak sharpens as δ falls and the Newton needs it resolved);
-    if that adds panels (within PMAX), its remaining fraction into s_new and its r (by
-    interpolation) into rr on the new mesh pan_new. Returns the new panel count."""
+    if that adds panels (within PMAX), its remaining fraction into new.c and its r (by
+    interpolation) into new.r on the new mesh new.pan (:class:`Mesh`). Returns the new panel
+    count."""
+    n, Lp, PMAX = rule.n, rule.Lp, rule.PMAX
+    pan_new = new.pan
     panel_series(r_prev, pan, P, n, Lp, coef, after)
     q = 0
     for p in range(P):
@@ -344,26 +417,27 @@ def _refine_previous(r_prev, pan, P, n, Lp, zl, PMAX, W_prev, coef, after, Pk, p
             q += 1
     pan_new[q] = 1.0
     if q > P and q <= PMAX:
-        _series_at_nodes(pan_new, q, zl, n, pan, P, coef, after, W_prev, Pk, True, s_new)
-        _series_at_nodes(pan_new, q, zl, n, pan, P, coef, after, W_prev, Pk, False, rr)
+        _series_at_nodes(pan_new, q, rule, pan, P, coef, after, W_prev, Pk, True, new.c)
+        _series_at_nodes(pan_new, q, rule, pan, P, coef, after, W_prev, Pk, False, new.r)
     return q
 
 
 @njit(cache=True)
-def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, pan_out, c_out, r_out):
+def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, out):
     """solve_case, and if Newton fails from the plain initial guess (close to percolation,
     where ln σ̄ falls by ~10³ per unit ln p), continuation in p_a: start where the peak
     contact pressure max p0 − p_a is 0.6 p_perc (or halfway in p_a for the average theory),
     then step the distance to percolation δ = p_perc − (max p0 − p_a) geometrically down to
     its target, each step starting from the previous solution on the previous mesh.
+    ``out`` (:class:`Mesh`) receives the final mesh, c and r.
     Returns (W, status, panels, error_estimate, newton_iterations, continuation_steps)."""
-    n, PMAX, zl, Lp = rule.n, rule.PMAX, rule.zl, rule.Lp
+    n, PMAX = rule.n, rule.PMAX
     gp = np.empty(3)
     if not zone_params(kind, base, xg, pg, pia, pib, gp):
         return 0.0, ST_NO_ZONE, 0, 0.0, 0, 0
     nil = np.empty(0)
-    W, st, P, est, its = solve_case(tab, sc, rule, rule.tol, rule.maxit, kind, gp, xg, pg, pia,
-                                    pib, pan_out, c_out, r_out, 0, nil, nil, nil)
+    W, st, P, est, its = solve_case(tab, sc, rule, rule.tol, rule.maxit,
+                                    Zone(kind, gp, xg, pg, pia, pib), out, 0, nil, nil, nil)
     if st != ST_NEWTON_FAILED:
         return W, st, P, est, its, 0
     cperc = sc.p_perc
@@ -376,8 +450,9 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, pan_out, c_o
     cc = np.empty(NMAX)
     rr = np.empty(NMAX)
     zone_params(kind, base, xg, pg, pa0, pib, gp)
-    W, st, P, est, it0 = solve_case(tab, sc, rule, 1e-2, rule.maxit, kind, gp, xg, pg, pa0, pib,
-                                    pan, cc, rr, 0, pan, sn, sn)
+    W, st, P, est, it0 = solve_case(tab, sc, rule, 1e-2, rule.maxit,
+                                    Zone(kind, gp, xg, pg, pa0, pib), Mesh(pan, cc, rr), 0, pan,
+                                    sn, sn)
     its += it0
     if st == ST_NEWTON_FAILED:
         return W, st, P, est, its, 0
@@ -400,14 +475,14 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, pan_out, c_o
         if lt == 1.0:
             pa = pia
         zone_params(kind, base, xg, pg, pa, pib, gp)
-        W2, st2, P2, est2, it2 = solve_case(tab, sc, rule, rule.tol, min(rule.maxit, 25), kind,
-                                            gp, xg, pg, pa, pib, pan_new, cc, rr, P, pan, sn,
-                                            s_new)
+        W2, st2, P2, est2, it2 = solve_case(tab, sc, rule, rule.tol, min(rule.maxit, 25),
+                                            Zone(kind, gp, xg, pg, pa, pib),
+                                            Mesh(pan_new, cc, rr), P, pan, sn, s_new)
         its += it2
         if st2 == ST_NEWTON_FAILED:
             # first refine the previous solution, then shorten the step
-            q = _refine_previous(r_prev, pan, P, n, Lp, zl, PMAX, W_prev, coef, after, Pk,
-                                 pan_new, s_new, rr)
+            q = _refine_previous(rule, r_prev, pan, P, W_prev, coef, after, Pk,
+                                 Mesh(pan_new, s_new, rr))
             if q > P and q <= PMAX:
                 P = q
                 _copy_mesh(P, n, pan_new, s_new, rr, pan, sn, r_prev)
@@ -424,44 +499,52 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, pan_out, c_o
         step = min(2.0 * step, 0.5)
     if lam < 1.0:
         return W, ST_NEWTON_FAILED, P, est, its, steps
-    _copy_mesh(P, n, pan, cc, rr, pan_out, c_out, r_out)
+    _copy_mesh(P, n, pan, cc, rr, out.pan, out.c, out.r)
     return W, st, P, est, its, steps
 
 
 @njit(cache=True)
-def solve_row(tab, sc, rule, kind, xg, p0n, amp, pia, pib, out, i, pan, cc, rr):
-    """Row i of a batch into ``out`` (flat record of arrays W, status, panels, err, xs, xe).
+def solve_row(tab, sc, rule, kind, xg, p0n, amp, pia, pib, mesh):
+    """One soft seal: (W, status, panels, error_estimate, x_s, x_e).
 
     kind 0, Hertz: amp = π_H (p0n unused); kind 1, array: p0 = p0n·amp at ξ = xg (p0n [Pa],
-    amp = 1/E*). Reduced π_a, π_b. W = ∫dξ/σ̄ over the sealing zone; pan / rr receive the
-    final mesh and resistance density (for the profile evaluation). Returns the panel count."""
+    amp = 1/E*). Reduced π_a, π_b. W = ∫dξ/σ̄ over the sealing zone; ``mesh``
+    (:class:`Mesh`) receives the final mesh, c and the resistance density (for the profile
+    evaluation); x_s, x_e the array profile's sealing zone (NaN for Hertz)."""
     if kind == 0:
         base1 = np.empty(1)
         base1[0] = amp
         W, st, P, est, its, cs = solve_robust(tab, sc, rule, 0, base1, xg, p0n, amp, pia, pib,
-                                              pan, cc, rr)
-        out.xs[i] = math.nan
-        out.xe[i] = math.nan
+                                              mesh)
+        xs = math.nan
+        xe = math.nan
     else:
         pg = p0n * amp
         xs, xe = array_zone(xg, pg, pia, pib)
-        out.xs[i] = xs
-        out.xe[i] = xe
         W, st, P, est, its, cs = solve_robust(tab, sc, rule, 1, pg, xg, pg, pg.max(), pia, pib,
-                                              pan, cc, rr)
+                                              mesh)
+    return W, st, P, est, xs, xe
+
+
+@njit(cache=True)
+def _store_row(out, i, W, st, P, est, xs, xe):
+    """Row i of the batch record ``out`` (W, status, panels, err, xs, xe)."""
+    out.xs[i] = xs
+    out.xe[i] = xe
     out.W[i] = W
     out.status[i] = st
     out.panels[i] = P
     out.err[i] = est
-    return P
 
 
 @njit(cache=True, parallel=True)
 def solve_rows(tab, sc, rule, kind, xg, p0n, amp, pia, pib, rows, out):
-    """Soft seals of the rows listed in ``rows`` (parallel; see :func:`solve_row`)."""
+    """Soft seals of the rows listed in ``rows`` (parallel; see :func:`solve_row`) into
+    ``out`` (flat record of arrays W, status, panels, err, xs, xe)."""
     for j in prange(rows.size):
         i = rows[j]
-        pan = np.empty(rule.PMAX + 1)
-        cc = np.empty(rule.PMAX * rule.n)
-        rr = np.empty(rule.PMAX * rule.n)
-        solve_row(tab, sc, rule, kind, xg, p0n, amp[i], pia[i], pib[i], out, i, pan, cc, rr)
+        mesh = Mesh(np.empty(rule.PMAX + 1), np.empty(rule.PMAX * rule.n),
+                    np.empty(rule.PMAX * rule.n))
+        W, st, P, est, xs, xe = solve_row(tab, sc, rule, kind, xg, p0n, amp[i], pia[i], pib[i],
+                                          mesh)
+        _store_row(out, i, W, st, P, est, xs, xe)

@@ -12,7 +12,7 @@ from . import _mesh, _panels, _sigma
 from ._inputs import (alpha_scale, check_tables, check_theory_for, common_inputs, hertz_contact,
                       profile_kind, scalar)
 from .api import EQUALITY_TOL, REFERENCES, seal_leak
-from .context import RowsOut, panel_rule, seal_context, solver_options
+from .context import panel_rule, seal_context, solver_options
 
 __all__ = ["seal_profile"]
 
@@ -162,16 +162,14 @@ def _general_fluid(sc, geo, pa, pb, dp, E, xo, row, o):
         xg = np.ascontiguousarray((xarr - x0) / L)
         pg = base = np.ascontiguousarray(p0x / E)
         p0n, amp = np.ascontiguousarray(p0x, dtype=np.float64), 1.0 / E
-    out = RowsOut.empty(1)
-    pan = np.empty(rule.PMAX + 1)
-    rr = np.empty(rule.PMAX * rule.n)
-    P = _panels.solve_row(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pa / E, pb / E, out, 0, pan,
-                          np.empty(rule.PMAX * rule.n), rr)
+    mesh = _panels.Mesh(np.empty(rule.PMAX + 1), np.empty(rule.PMAX * rule.n),
+                        np.empty(rule.PMAX * rule.n))
+    W, _, P, _, _, _ = _panels.solve_row(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pa / E,
+                                         pb / E, mesh)
     gp = np.empty(3)
     _mesh.zone_params(kind, base, xg, pg, pa / E, pb / E, gp)
     frac = np.empty(n_out)
-    _mesh.remaining_at(kind, gp, xo, x0, ell, rule.m, pan, P, rule.n, rr, float(out.W[0]),
-                       rule.Lp, frac)
+    _mesh.remaining_at(kind, gp, xo, x0, ell, rule, mesh.pan, P, mesh.r, float(W), frac)
     pf = pb + dp * frac
     pf = np.where(xo <= x_s, pa, np.where(xo >= x_e, pb, pf))
     return pf, x_s, x_e
