@@ -16,6 +16,7 @@ the bound 0 <= σ̄ <= σ̄(π_trust) there (σ̄ falls with p_cont) and is flag
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -24,9 +25,9 @@ from ._lookup import _sig_fast
 from ._primitive import (P_OK, P_T, _adaptive, _asym, _gl_s, _left, _right, _split, _whole,
                          asym_primitive)
 
-__all__ = ["leak_integral", "uniform_rows", "invert_uniform", "ST_OK", "ST_LIFT_OFF", "ST_OPEN",
-           "ST_PERCOLATED", "ST_ABOVE_TABLE", "ST_NOT_CONVERGED", "ST_NEAR_PERCOLATION",
-           "TAIL_RTOL", "SHORT_RTOL"]
+__all__ = ["leak_integral", "uniform_rows", "RingRows", "RingOut", "invert_uniform", "ST_OK",
+           "ST_LIFT_OFF", "ST_OPEN", "ST_PERCOLATED", "ST_ABOVE_TABLE", "ST_NOT_CONVERGED",
+           "ST_NEAR_PERCOLATION", "TAIL_RTOL", "SHORT_RTOL"]
 
 #: row status codes (``fastcontact.seal.api.STATUS`` names them)
 (ST_OK, ST_LIFT_OFF, ST_OPEN, ST_PERCOLATED, ST_ABOVE_TABLE, ST_NOT_CONVERGED,
@@ -208,21 +209,51 @@ def _ring_case(p0_i, dp_i, pb_i, E_i, pa, p_perc, p_top):
     return st, False, 0.0, c_hi, w
 
 
+class RingRows(NamedTuple):
+    """Inputs of :func:`uniform_rows` in SI (one argument instead of eight), each contiguous
+    1-D of size 1 (broadcast) or n (one value per row): p0 [Pa], L [m], dp [Pa], L_y [m],
+    E* [Pa], η [Pa·s], p_b [Pa], α_cj [-]."""
+
+    p0: np.ndarray
+    L: np.ndarray
+    dp: np.ndarray
+    L_y: np.ndarray
+    E: np.ndarray
+    eta: np.ndarray
+    p_b: np.ndarray
+    alpha: np.ndarray
+
+
+class RingOut(NamedTuple):
+    """Outputs of :func:`uniform_rows` (one argument instead of seven), n rows each: Q [m³/s],
+    status (int8), p_a [Pa], lift_off, percolated (bool), open_inlet [m]; ``echo`` (8, n or
+    0) the broadcast size-1 inputs."""
+
+    Q: np.ndarray
+    status: np.ndarray
+    p_a: np.ndarray
+    lift: np.ndarray
+    perc: np.ndarray
+    open_in: np.ndarray
+    echo: np.ndarray
+
+
 @njit(cache=True, parallel=True)
-def uniform_rows(tab, sc, p0, L, dp, L_y, E, eta, p_b, alpha, cj, alpha_table,
-                 Q, status, p_a, lift, perc, open_in, echo, need):
+def uniform_rows(tab, sc, rows, cj, alpha_table, out, need):
     """Flat ring (eq. 32 with the fluid feedback): Q = (L_y/L) (h³E*/12η) ∫ σ̄ dπ per row.
 
-    Inputs in SI, contiguous 1-D, each of size 1 (broadcast) or n (one value per row);
-    ``cj``: scale σ̄ by (alpha/alpha_table)³. Writes Q [m³/s], the status code, p_a = p_b + dp,
-    lift_off (p_a >= p0), percolated, open_inlet [m], and, where ``need[j]`` (inputs of size
-    1), ``echo[j]``: the j-th input of (p0, L, dp, L_y, E, eta, p_b, alpha) repeated per row
-    (shape (8, n); rows not needed are never touched).
+    Inputs ``rows`` (:class:`RingRows`) in SI, contiguous 1-D, each of size 1 (broadcast) or
+    n (one value per row); ``cj``: scale σ̄ by (alpha/alpha_table)³. Writes into ``out``
+    (:class:`RingOut`) Q [m³/s], the status code, p_a = p_b + dp, lift_off (p_a >= p0),
+    percolated, open_inlet [m], and, where ``need[j]`` (inputs of size 1), ``echo[j]``: the
+    j-th input of (p0, L, dp, L_y, E, eta, p_b, alpha) repeated per row (shape (8, n); rows
+    not needed are never touched).
 
     Contact pressures past π_trust (the tables' unverified tail) enter through the bound
     0 <= σ̄ <= σ̄(π_trust): Q takes the midpoint, and the row is ST_NEAR_PERCOLATION with
     Q = NaN when the bound is wider than TAIL_RTOL of the verified part."""
-    n = Q.size
+    p0, L, dp, L_y, E, eta, p_b, alpha = rows
+    n = out.Q.size
     h3 = sc.h_rms ** 3
     P, B, R, TQ, TQB, HS, G = sc.P, sc.B, sc.R, sc.TQ, sc.TQB, sc.HS, sc.G
     pi_trust, sig_trust, p_perc, p_top = sc.pi_trust, sc.sig_trust, sc.p_perc, sc.p_top
@@ -239,18 +270,14 @@ def uniform_rows(tab, sc, p0, L, dp, L_y, E, eta, p_b, alpha, cj, alpha_table,
         E_i = E[i & m4]
         pb_i = p_b[i & m6]
         if ne:
-            for j in range(8):
-                if need[j]:
-                    echo[j, i] = first[j]
+            _put_echo(out, i, need, first)
         pa = pb_i + dp_i
-        p_a[i] = pa
-        lift[i] = pa >= p0_i
         st, done, q, c_hi, w = _ring_case(p0_i, dp_i, pb_i, E_i, pa, p_perc, p_top)
-        perc[i] = st == ST_PERCOLATED
-        open_in[i] = L_i if st == ST_OPEN else 0.0
+        lift_i = pa >= p0_i
+        perc_i = st == ST_PERCOLATED
+        open_i = L_i if st == ST_OPEN else 0.0
         if done:
-            Q[i] = q
-            status[i] = st
+            _put_row(out, i, q, st, pa, lift_i, perc_i, open_i)
             continue
         if c_hi <= pi_trust:
             I = _fast_integral(P, B, R, TQ, TQB, HS, G, c_hi, w)
@@ -276,8 +303,29 @@ def uniform_rows(tab, sc, p0, L, dp, L_y, E, eta, p_b, alpha, cj, alpha_table,
         if cj:
             r = alpha[i & m7] / alpha_table
             scale = r * r * r
-        Q[i] = L_y[i & m3] * h3 * E_i / (12.0 * eta[i & m5] * L_i) * scale * I
-        status[i] = st
+        _put_row(out, i, L_y[i & m3] * h3 * E_i / (12.0 * eta[i & m5] * L_i) * scale * I, st, pa,
+                 lift_i, perc_i, open_i)
+
+
+@njit(cache=True)
+def _put_row(out, i, q, st, pa, lift, perc, open_in):
+    """Row i of the flat-ring outputs :class:`RingOut`. Stored by a call, not in the prange
+    body: numba 0.68's parfor pass drops stores made there into arrays taken from a
+    namedtuple argument (it does not see that they alias the argument)."""
+    out.Q[i] = q
+    out.status[i] = st
+    out.p_a[i] = pa
+    out.lift[i] = lift
+    out.perc[i] = perc
+    out.open_in[i] = open_in
+
+
+@njit(cache=True)
+def _put_echo(out, i, need, first):
+    """out.echo[j, i] = first[j] where need[j] (a call: see :func:`_put_row`)."""
+    for j in range(8):
+        if need[j]:
+            out.echo[j, i] = first[j]
 
 
 @njit(cache=True)
