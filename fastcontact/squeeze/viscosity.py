@@ -36,7 +36,7 @@ from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
 from .api import register_extension, squeeze_out
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
-from ._kernels import Cases, Quad
+from ._kernels import LIN_REL, Cases, Quad, near_equilibrium, tail_sigma
 
 __all__ = [
     "DEFAULT_P_START",
@@ -130,10 +130,11 @@ def barus_rate_factor(a):
 # =========================================================================== kernels
 @njit(cache=True)
 def _state(tab, sc, v):
-    """(ln π_c, σ̄) at v = ū/h_rms; above the table top: eq. (3) tail and σ̄ ∝ v³."""
+    """(ln π_c, σ̄) at v = ū/h_rms; above the table top: eq. (3) tail and the squeeze model's
+    tail σ̄ (fitted to the tables' direct samples; :func:`~fastcontact.tables.tail.fit_tail`)."""
     s = sc[0]
     if v > s.v_top:
-        return s.x_min - (v - s.v_top) / s.u0, math.exp(s.lnsig_top) * (v / s.v_top) ** 3
+        return s.x_min - (v - s.v_top) / s.u0, tail_sigma(s, v)[0]
     lnp = k_lnp_of_lnu(tab, math.log(v))
     if lnp >= s.x_trap:
         return lnp, 0.0
@@ -179,10 +180,14 @@ def _start(tab, sc, x0, u_start, h):
 def _integrand(tab, sc, x0, api, vinf, w):
     """dt̃/dw at w = ln(v - v∞): (v - v∞)/(σ̄ d g(api d)), d = 1 - π_c/π0; 0 if σ̄ = 0."""
     e = math.exp(w)
-    lnp, sig = _state(tab, sc, vinf + e)
+    d = math.nan
+    if e < LIN_REL * vinf:  # as the constant-viscosity quadrature (squeeze._kernels._dtdw)
+        sig, d = near_equilibrium(tab, x0, vinf, e / vinf)
+    if d != d:
+        lnp, sig = _state(tab, sc, vinf + e)
+        d = -math.expm1(lnp - x0)
     if not (sig > 0.0):
         return math.inf
-    d = -math.expm1(lnp - x0)
     d = max(1e-300, d)
     g = _rate_factor(api * d) if api > 0.0 else 1.0
     return e / (sig * d * g)
@@ -213,22 +218,24 @@ def _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i):
     vt_dv = tg.dvs
     nt = T.shape[0]
     nr = vt_ratio.size
-    vts = np.empty(nt)
+    # targets as w = ln(v - v∞): a Δu target is ln Δu exactly, even below the resolution of
+    # v∞ (v∞ + Δu == v∞ in float64 gave ln 0 = -inf and t = inf, unflagged)
+    wts = np.empty(nt)
     for k in range(nt):
-        vts[k] = vt_ratio[k] * vinf if k < nr else vinf + vt_dv[k - nr]
-    order = np.argsort(-vts)
-    v_cur = vs
+        wts[k] = math.log(vt_ratio[k] * vinf - vinf) if k < nr else math.log(vt_dv[k - nr])
+    order = np.argsort(-wts)
+    w_s = math.log(vs - vinf)
+    w_cur = w_s
     t_cur = 0.0
     for kk in range(nt):
         k = order[kk]
-        vt = vts[k]
-        if vt >= vs:
+        wt = wts[k]
+        if wt >= w_s:
             T[k, i] = 0.0
             continue
-        if vt < v_cur:
-            t_cur += _segment(tab, sc, x0, api, vinf, math.log(vt - vinf),
-                              math.log(v_cur - vinf), quad)
-            v_cur = vt
+        if wt < w_cur:
+            t_cur += _segment(tab, sc, x0, api, vinf, wt, w_cur, quad)
+            w_cur = wt
         T[k, i] = tau * t_cur
 
 
@@ -289,13 +296,16 @@ _SC_CACHE = {}
 
 def _scalars(tables, theory, sigma_trap):
     """The scalar record of (tables, theory): the table range, the tail above its top and the
-    trap (one record, so that the kernels read the six by name).
+    trap (one record, so that the kernels read them by name).
 
     Fields: x_min, x_max = ln π of the tables' ends [-]; v_top = ū/h_rms at the table top [-];
-    u0 = -dv/d ln π there (eq. (3) tail) [-]; lnsig_top = ln σ̄ at the top [-]; x_trap = ln π
-    above which σ̄ is below the trap floor (inf: never) [-].
+    u0 = -dv/d ln π there (eq. (3) tail) [-]; x_trap = ln π
+    above which σ̄ is below the trap floor (inf: never) [-]; d, cn, g1..g5: the squeeze
+    model's σ̄ tail above the top (:data:`~fastcontact.squeeze.model.ModelPar`) [-].
     """
-    key = (id(tables), tables.surface.fingerprint(), theory, sigma_trap)
+    from .model import squeeze_model
+    key = (id(tables), tables.surface.fingerprint(), theory, sigma_trap,
+           repr(tables.info.get("tail")), repr(sorted(tables.options.items())))
     if key in _SC_CACHE:
         return _SC_CACHE[key]
     p_lo, p_hi = tables.p_range
@@ -303,7 +313,6 @@ def _scalars(tables, theory, sigma_trap):
     d = 1e-4
     v = tables.mean_separation(np.array([p_lo, p_lo * math.exp(d)]), 1.0) / tables.h_rms
     u0 = (v[0] - v[1]) / d
-    sig_top = float(tables.sigma_bar(p_lo, 1.0, theory))
     floor = float(tables.info.get("sigma_floor", 1e-24) if sigma_trap is None else sigma_trap)
     perc = tables.info["percolation_p_over_E"][theory]
     x_trap = math.inf
@@ -320,8 +329,10 @@ def _scalars(tables, theory, sigma_trap):
             x_trap = hi
         elif math.log(perc) <= x_max:
             x_trap = math.log(perc)
-    sc = scalar_record({"x_min": x_min, "v_top": v[0], "u0": u0, "lnsig_top": math.log(sig_top),
-                        "x_trap": x_trap, "x_max": x_max})
+    mp = squeeze_model(tables, theory).mp
+    sc = scalar_record({"x_min": x_min, "v_top": v[0], "u0": u0,
+                        "x_trap": x_trap, "x_max": x_max, "d": mp.d, "cn": mp.cn, "g1": mp.g1,
+                        "g2": mp.g2, "g3": mp.g3, "g4": mp.g4, "g5": mp.g5})
     _SC_CACHE[key] = sc
     return sc
 
