@@ -11,6 +11,7 @@ B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019.
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from typing import NamedTuple
 
 import numpy as np
@@ -87,6 +88,10 @@ def critical_junction_kernel(sk, pbar, gamma, a_perc, ktab, glx, glw, panel, u1c
 
 
 _XGK, _WGK, _WG7 = gauss_kronrod15()
+#: the Kronrod nodes of all panels of :func:`emt_sigma` (panel k at 15k .. 15k + 14):
+#: sig = σ̄ of the node (inf: masked) [-], hz = its Almqvist width [h_rms], wk, wg = its
+#: Kronrod and embedded-Gauss weights in A [-]
+_Nodes = namedtuple("_Nodes", "sig hz wk wg")
 #: target relative accuracy of the effective-medium σ̄ (adaptive quadrature in A)
 EMT_TOL = 1e-8
 EMT_MAX_PANELS = 96
@@ -217,8 +222,13 @@ def bruggeman(W, sig, A1, almqvist, hz, ghx, ghw, guess=0.0, threshold=0.5):
 
 
 @njit(cache=True)
-def _emt_fill_panel(sk, pbar, A1, t0, t1, ktab, spec, work, sig, hz, WK, WG, off):
-    """u1-based σ(u) at the 15 Kronrod nodes of panel [t0, t1] of the graded variable t."""
+def _emt_fill_panel(sk, pbar, A1, t0, t1, ktab, spec, work, nodes, off):
+    """u1-based σ(u) at the 15 Kronrod nodes of panel [t0, t1] of the graded variable t, into
+    ``nodes`` (:data:`_Nodes`) from index ``off``."""
+    sig = nodes.sig
+    hz = nodes.hz
+    WK = nodes.wk
+    WG = nodes.wg
     h_rms = spec.h_rms
     m = EMT_GRADE
     half = 0.5 * (t1 - t0)
@@ -268,11 +278,12 @@ def emt_sigma(sk, pbar, ktab, spec):
     pt0 = np.empty(EMT_MAX_PANELS)
     pt1 = np.empty(EMT_MAX_PANELS)
     work = np.empty(4)
+    nodes = _Nodes(sig, hz, WK, WG)
     npan = spec.n_start
     for k in range(npan):
         pt0[k] = k / npan
         pt1[k] = (k + 1) / npan
-        _emt_fill_panel(sk, pbar, A1, pt0[k], pt1[k], ktab, spec, work, sig, hz, WK, WG, 15 * k)
+        _emt_fill_panel(sk, pbar, A1, pt0[k], pt1[k], ktab, spec, work, nodes, 15 * k)
     s = 0.0
     est = 0.0
     while True:
@@ -306,10 +317,10 @@ def emt_sigma(sk, pbar, ktab, spec):
         a1 = pt1[worst]
         am = 0.5 * (a0 + a1)
         pt1[worst] = am
-        _emt_fill_panel(sk, pbar, A1, a0, am, ktab, spec, work, sig, hz, WK, WG, 15 * worst)
+        _emt_fill_panel(sk, pbar, A1, a0, am, ktab, spec, work, nodes, 15 * worst)
         pt0[npan] = am
         pt1[npan] = a1
-        _emt_fill_panel(sk, pbar, A1, am, a1, ktab, spec, work, sig, hz, WK, WG, 15 * npan)
+        _emt_fill_panel(sk, pbar, A1, am, a1, ktab, spec, work, nodes, 15 * npan)
         npan += 1
 
 

@@ -23,6 +23,10 @@ __all__ = ["fast_kernel", "history_kernel", "one_case_primitive", "RowTargets", 
 #: A case interpolates them in x0 with the same 4-point stencil as everything else, so a
 #: default-start ratio target costs four loads and one exp.
 RowTargets = namedtuple("RowTargets", "lnT lnTs")
+#: the per-call target tables of :func:`fast_kernel` (built in the kernel, before its loop):
+#: r1s = ū/ū∞ - 1 of t_star and the ratios [-], zr = ln r1s, dvs = Δu/h_rms of the Δu
+#: targets [-], lnT the :data:`RowTargets` table of the ratio targets
+ZTargets = namedtuple("ZTargets", "r1s zr dvs lnT")
 #: a per-case start within GUARD_Z (in z = ln(ū/ū∞ - 1)) above a target takes the target
 #: from the same interpolant as the start (t_of_z), so that the difference stays >= 0
 GUARD_Z = 1.0
@@ -141,15 +145,17 @@ def _case_start(pr, st, vinf, vs_in, lnTs):
 
 
 @njit(cache=True, inline="always")
-def _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, nr, r1s, zr, dvs, lnT):
-    """(t [s] from the start to target k, Ts): target k <= nr is t_star or a ratio (z from
-    ``zr``), above nr a Δu target; 0 for a target at or above the start."""
-    r1 = r1s[k] if k <= nr else dvs[k - 1 - nr] / vinf
+def _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, zt):
+    """(t [s] from the start to target k, Ts): with nr = zt.r1s.size - 1 ratio targets, target
+    k <= nr is t_star or a ratio (z from ``zt.zr``), above nr a Δu target; 0 for a target at
+    or above the start. ``zt`` a :data:`ZTargets`."""
+    nr = zt.r1s.size - 1
+    r1 = zt.r1s[k] if k <= nr else zt.dvs[k - 1 - nr] / vinf
     if vinf * (1.0 + r1) >= vs:
         return 0.0, Ts
-    z = zr[k] if k <= nr else math.log(r1)
+    z = zt.zr[k] if k <= nr else math.log(r1)
     if k <= nr and z < zs - GUARD_Z:
-        return tau * (math.exp(_row_col(lnT, st, k)) - Ts_row), Ts
+        return tau * (math.exp(_row_col(zt.lnT, st, k)) - Ts_row), Ts
     if Ts < 0.0:  # near the start: both ends from the same interpolant
         Ts = t_of_z(pr, st, vinf, zs)
     return tau * (t_of_z(pr, st, vinf, z) - Ts), Ts
@@ -208,6 +214,7 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
     r1s[0] = 0.01
     r1s[1:] = tg.ratios - 1.0
     zr = np.log(r1s)
+    zt = ZTargets(r1s, zr, dvs, lnT)
     for i in prange(p0.size):
         tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
         x0 = math.log(p0[i] / E[i])
@@ -230,7 +237,7 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
         flf[i] = 0.0
         bad = not (0.0 < tau < math.inf)
         for k in range(nT):
-            tk, Ts = _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, nr, r1s, zr, dvs, lnT)
+            tk, Ts = _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, zt)
             T_out[k, i] = tk
             bad = bad or tk == math.inf
         if nU > 0 and Ts < 0.0:
