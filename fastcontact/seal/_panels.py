@@ -341,23 +341,23 @@ def solve_case(tab, sc, rule, tol, maxit, zone, out, init_P, init_pan, init_s, s
     total_it = 0
     est = math.inf
     W = 0.0
-    for rnd in range(4 * PMAX):
-        # intermediate meshes: converge loosely (the indicator needs r to ~1e-9 only)
-        W, its, conv = _newton(tab, sc, rule, wk, dpi, P, maxit, 1e4 * ftol)
+    polish = False
+    for rnd in range(4 * PMAX + 1):
+        # intermediate meshes: converge loosely (the indicator needs r to ~1e-9 only); the
+        # final mesh: polish to round-off (each round adds a panel: the bound is never reached)
+        W, its, conv = _newton(tab, sc, rule, wk, dpi, P, maxit, ftol if polish else 1e4 * ftol)
         total_it += its
         if not conv:
             status = ST_NEWTON_FAILED
+            break
+        if polish:
             break
         nsplit, est = _indicator(r, pan, P, n, Lp, coef, after, W, tol, err)
         if nsplit == 0 or P + nsplit > PMAX:
             if nsplit > 0:
                 status = ST_NOT_REFINED
-            # final mesh: polish to round-off
-            W, its, conv = _newton(tab, sc, rule, wk, dpi, P, maxit, ftol)
-            total_it += its
-            if not conv:
-                status = ST_NEWTON_FAILED
-            break
+            polish = True
+            continue
         Pn = _halve(pan, P, err, tol, pan2)
         # new nodes: remaining fraction s(t) of the converged solution, then c = e_b − Δπ s
         _series_at_nodes(pan2, Pn, rule, pan, P, coef, after, W, Pk, True, y1)
