@@ -32,11 +32,12 @@ from numba import njit, prange
 
 from .._core.validate import check_positive
 from .._core.vocab import DEFAULT_THEORY, column_name
-from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
+from ..tables import k_lnp_of_lnu, k_sigma_of_lnp
 from .api import register_extension, squeeze_out
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from ._kernels import LIN_REL, Cases, Quad, near_equilibrium, tail_sigma
+from ._kernels import _lnv_of_lnp as qk_lnv_of_lnp
 
 __all__ = [
     "DEFAULT_P_START",
@@ -143,26 +144,9 @@ def _state(tab, sc, v):
 
 @njit(cache=True)
 def _lnv_of_lnp(tab, sc, x):
-    """ln v with π_c(v) = e^x for the inverse interpolant (Newton on k_lnp_of_lnu)."""
-    s = sc[0]
-    if x <= s.x_min:
-        return math.log(s.v_top + s.u0 * (s.x_min - x))
-    y = k_lnu_of_lnp(tab, x)
-    hh = 1e-6
-    for _ in range(6):
-        f = k_lnp_of_lnu(tab, y) - x
-        fp = k_lnp_of_lnu(tab, y + hh)
-        fm = k_lnp_of_lnu(tab, y - hh)
-        if not (fp == fp and fm == fm):
-            break
-        slope = (fp - fm) / (2.0 * hh)
-        if not (slope < 0.0):
-            break
-        step = f / slope
-        y -= step
-        if abs(step) < 1e-15:
-            break
-    return y
+    """ln v with π_c(v) = e^x: the constant-viscosity model's inverse (the record carries the
+    same x_min, v_top, u0 as its ModelPar)."""
+    return qk_lnv_of_lnp(tab, sc[0], x)
 
 
 @njit(cache=True)
