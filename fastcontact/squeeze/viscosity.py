@@ -32,12 +32,12 @@ from numba import njit, prange
 
 from .._core.validate import check_positive
 from .._core.vocab import DEFAULT_THEORY, column_name
-from ..tables import k_lnp_of_lnu, k_sigma_of_lnp
 from .api import register_extension, squeeze_out
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
-from ._kernels import LIN_REL, Cases, Quad, near_equilibrium, tail_sigma
+from ._kernels import LIN_REL, Cases, Quad, near_equilibrium
 from ._kernels import _lnv_of_lnp as qk_lnv_of_lnp
+from ._kernels import _state as qk_state
 
 __all__ = [
     "DEFAULT_P_START",
@@ -131,15 +131,9 @@ def barus_rate_factor(a):
 # =========================================================================== kernels
 @njit(cache=True)
 def _state(tab, sc, v):
-    """(ln π_c, σ̄) at v = ū/h_rms; above the table top: eq. (3) tail and the squeeze model's
-    tail σ̄ (fitted to the tables' direct samples; :func:`~fastcontact.tables.tail.fit_tail`)."""
-    s = sc[0]
-    if v > s.v_top:
-        return s.x_min - (v - s.v_top) / s.u0, tail_sigma(s, v)[0]
-    lnp = k_lnp_of_lnu(tab, math.log(v))
-    if lnp >= s.x_trap:
-        return lnp, 0.0
-    return lnp, k_sigma_of_lnp(tab, lnp)
+    """(ln π_c, σ̄) at v = ū/h_rms: the constant-viscosity model's state (tables; above the
+    top the eq. (3) tail and the σ̄ tail fitted to the tables' direct samples)."""
+    return qk_state(tab, sc[0], v)
 
 
 @njit(cache=True)
