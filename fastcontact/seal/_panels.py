@@ -107,13 +107,12 @@ def _fill_nodes(zone, rule, wk, P):
 
 
 @njit(cache=True)
-def _resid(tab, sc, rule, wk, st, dpi, P):
-    """r = dξ/dt / σ̄(c), D = dr/dc, R̃ and F at c (the :class:`State` st) on the mesh wk.pan;
-    returns (W, max|F|, ok).
+def _resid(tab, sc, rule, st, dxi, eb, dpi, pan, P):
+    """r = dξ/dt / σ̄(c), D = dr/dc, R̃ and F at c (the :class:`State` st) on the mesh pan;
+    returns (W, max|F|, ok). Not the whole :class:`Work`: it is called per line-search step.
 
     ok is False if σ̄ = 0 somewhere (c at/after percolation: infinite resistance)."""
     n, wl, At = rule.n, rule.wl, rule.At
-    dxi, eb, pan = wk.dxi, wk.eb, wk.pan
     c, r, D, Rt, F = st
     N = P * n
     for i in range(N):
@@ -155,9 +154,9 @@ def _newton(tab, sc, rule, wk, dpi, P, maxit, ftol):
     """Damped Newton on the current mesh wk.pan from wk.s0; wk.s0.c and wk.s0.r hold the
     result. Returns (W, its, ok)."""
     n, wl, At = rule.n, rule.wl, rule.At
-    pan, y1, y2, Y, K = wk.pan, wk.y1, wk.y2, wk.Y, wk.K
+    pan, y1, y2, Y, K, dxi, eb = wk.pan, wk.y1, wk.y2, wk.Y, wk.K, wk.dxi, wk.eb
     N = P * n
-    W, fmax, ok = _resid(tab, sc, rule, wk, wk.s0, dpi, P)
+    W, fmax, ok = _resid(tab, sc, rule, wk.s0, dxi, eb, dpi, pan, P)
     if not ok:
         return W, 0, False
     cur = 0          # 0: current state in wk.s0; 1: in wk.s1
@@ -206,7 +205,7 @@ def _newton(tab, sc, rule, wk, dpi, P, maxit, ftol):
         for ls in range(24):
             for i in range(N):
                 ct[i] = cc[i] + lam * y1[i]
-            Wt, ft, okt = _resid(tab, sc, rule, wk, trial, dpi, P)
+            Wt, ft, okt = _resid(tab, sc, rule, trial, dxi, eb, dpi, pan, P)
             if okt and ft <= (1.0 - 1e-4 * lam) * fmax:
                 accepted = True
                 break
