@@ -131,15 +131,23 @@ def near_equilibrium(tab, x0, vb, r):
 
 
 @njit(cache=True)
-def _dtdw(tab, mp, x0, vb, w):
-    """dt̃/dw at w = ln(v - vb): (v - vb) / (σ̄ (1 - π_c/π0)); 0 where σ̄ = 0 (trapped)."""
-    e = math.exp(w)
+def state_gap(tab, mp, x0, vb, e):
+    """(σ̄, 1 - π_c/π0) at v = vb + e: :func:`near_equilibrium` within LIN_REL of an
+    equilibrium vb, else the model's state (:func:`_state`)."""
     d = math.nan
     if e < LIN_REL * vb:
         sig, d = near_equilibrium(tab, x0, vb, e / vb)
     if d != d:
         lnp, sig = _state(tab, mp, vb + e)
         d = -math.expm1(lnp - x0)
+    return sig, d
+
+
+@njit(cache=True)
+def _dtdw(tab, mp, x0, vb, w):
+    """dt̃/dw at w = ln(v - vb): (v - vb) / (σ̄ (1 - π_c/π0)); 0 where σ̄ = 0 (trapped)."""
+    e = math.exp(w)
+    sig, d = state_gap(tab, mp, x0, vb, e)
     if not (sig > 0.0):
         return 0.0
     if d <= 1e-300:

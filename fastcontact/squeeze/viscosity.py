@@ -35,7 +35,7 @@ from .._core.vocab import DEFAULT_THEORY, column_name
 from .api import register_extension, squeeze_out
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
-from ._kernels import LIN_REL, Cases, Quad, near_equilibrium
+from ._kernels import Cases, Quad, state_gap
 from ._kernels import _lnv_of_lnp as qk_lnv_of_lnp
 from ._kernels import _state as qk_state
 
@@ -158,12 +158,7 @@ def _start(tab, sc, x0, u_start, h):
 def _integrand(tab, sc, x0, api, vinf, w):
     """dt̃/dw at w = ln(v - v∞): (v - v∞)/(σ̄ d g(api d)), d = 1 - π_c/π0; 0 if σ̄ = 0."""
     e = math.exp(w)
-    d = math.nan
-    if e < LIN_REL * vinf:  # as the constant-viscosity quadrature (squeeze._kernels._dtdw)
-        sig, d = near_equilibrium(tab, x0, vinf, e / vinf)
-    if d != d:
-        lnp, sig = _state(tab, sc, vinf + e)
-        d = -math.expm1(lnp - x0)
+    sig, d = state_gap(tab, sc[0], x0, vinf, e)  # as the constant-viscosity quadrature
     if not (sig > 0.0):
         return math.inf
     d = max(1e-300, d)
