@@ -163,12 +163,9 @@ def separation_rate_reduced(u, kappa, alpha):
 
     Parameters
     ----------
-    u : array_like
-        Separation ū [h_rms], ≥ 0.
-    kappa : array_like
-        p0/(βE*) [-], > 0.
-    alpha : array_like
-        h_rms/u0 [-], > 0.
+    u, kappa, alpha : array_like
+        As in :func:`contact_pressure_reduced`: ū [h_rms] ≥ 0, κ = p0/(βE*) [-] > 0,
+        α = h_rms/u0 [-] > 0.
     """
     u, kappa, alpha = _checked_state(u, kappa, alpha)
     return _scalar_or_array(u**3 * np.expm1(-alpha * u - np.log(kappa)) / alpha)
