@@ -255,6 +255,15 @@ def test_shipped_default_tables_match_a_fresh_build(name):
     fresh = precompute(default_surface(name), theories=shipped.theories, gamma=shipped.options["gamma"],
                        a_perc=shipped.options["a_perc"], alpha_cj=shipped.options["alpha_cj"])
     assert_same_build(fresh, shipped, name)
+    # the tail samples (direct ū, σ̄ below the table; the squeeze engine's tail is fitted to them)
+    assert "tail" in shipped.info, f"tables/{name}.parquet has no tail samples: stale"
+    a, b = shipped.info["tail"], fresh.info["tail"]
+    for k in ("ln_p_over_E", "u_over_h"):
+        np.testing.assert_allclose(a[k], b[k], rtol=RTOL_VALUES, atol=0.0, err_msg=k)
+    assert set(a["sigma_bar"]) == set(shipped.theories)
+    for th in shipped.theories:
+        np.testing.assert_allclose(a["sigma_bar"][th], b["sigma_bar"][th], rtol=1e-8, atol=0.0,
+                                   err_msg=f"tail sigma_bar {th}")
     for k, v in shipped.info["interpolation_error"].items():
         assert v <= (1e-6 if k in ("u", "p_of_u") else 1e-4), (k, v)
 

@@ -264,7 +264,7 @@ X_FALLBACK = 0.01
 def _kink(model):
     """ln p̄ of the tables' last node with σ̄ > 0: beyond it σ̄^(1/3) is linear to the exact
     percolation pressure, so ln σ̄ has a kink there that no smooth grid may straddle."""
-    lnp, n_open = model.tab[0], int(model.tab[6])
+    lnp, n_open = model.tab.lnp, int(model.tab.n_open)
     return float(lnp[n_open - 1]) if n_open < lnp.size else math.inf
 
 
