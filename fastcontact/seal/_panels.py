@@ -16,13 +16,13 @@ Next to percolation a failed Newton is continued in p_a from an easier problem
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
 
 from ._mesh import (array_zone, geometry, interp_series, panel_series, remaining_fraction,
                     solve_small, zone_params)
+from ._panel_records import Mesh, State, Work, Zone, _work
 from ._sigma import sig_d
 
 __all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "ST_OK", "ST_NOT_REFINED",
@@ -30,64 +30,6 @@ __all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "ST_OK", "ST
 
 #: status codes of solve_case
 ST_OK, ST_NOT_REFINED, ST_NEWTON_FAILED, ST_NO_ZONE = 0, 1, 2, 3
-
-
-class Zone(NamedTuple):
-    """The sealing zone of one case (one argument instead of six): profile kind (0 Hertz,
-    1 array), zone parameters gp (:func:`._mesh.zone_params`), the array profile's samples
-    xg, pg, and the reduced pressures π_a, π_b at the ends."""
-
-    kind: int
-    gp: np.ndarray
-    xg: np.ndarray
-    pg: np.ndarray
-    pia: float
-    pib: float
-
-
-class State(NamedTuple):
-    """One Newton state at the nodes: contact pressure c, resistance density r = dξ/dt / σ̄(c),
-    D = dr/dc, tail integrals R̃ and residuals F."""
-
-    c: np.ndarray
-    r: np.ndarray
-    D: np.ndarray
-    Rt: np.ndarray
-    F: np.ndarray
-
-
-class Work(NamedTuple):
-    """Work arrays of one soft-seal solve, allocated once per case (one argument instead of
-    two dozen): node positions t, ξ, dξ/dt, e_a, e_b; Newton's current and trial states
-    (:class:`State`); the right-hand sides y1, y2 and the panel blocks Y (n×2), K (n×n); the
-    mesh pan and its refinement pan2, panel errors err; the Legendre series coef, after, Pk."""
-
-    t: np.ndarray
-    xi: np.ndarray
-    dxi: np.ndarray
-    ea: np.ndarray
-    eb: np.ndarray
-    s0: State
-    s1: State
-    y1: np.ndarray
-    y2: np.ndarray
-    Y: np.ndarray
-    K: np.ndarray
-    pan: np.ndarray
-    pan2: np.ndarray
-    err: np.ndarray
-    coef: np.ndarray
-    after: np.ndarray
-    Pk: np.ndarray
-
-
-class Mesh(NamedTuple):
-    """A solution on its mesh: panel edges pan (PMAX+1), nodal contact pressure c and
-    resistance density r (PMAX·n)."""
-
-    pan: np.ndarray
-    c: np.ndarray
-    r: np.ndarray
 
 
 @njit(cache=True)
@@ -225,21 +167,6 @@ def _newton(tab, sc, rule, wk, dpi, P, maxit, ftol):
             c[i] = c2[i]
             r[i] = r2[i]
     return W, its, conv
-
-
-@njit(cache=True)
-def _state(N):
-    return State(np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N))
-
-
-@njit(cache=True)
-def _work(n, PMAX):
-    """The :class:`Work` of a mesh of up to PMAX panels of n nodes."""
-    N = PMAX * n
-    return Work(np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N), _state(N),
-                _state(N), np.empty(N), np.empty(N), np.empty((n, 2)), np.empty((n, n)),
-                np.empty(PMAX + 1), np.empty(PMAX + 1), np.empty(PMAX), np.empty((PMAX, n)),
-                np.empty(PMAX), np.empty(n + 1))
 
 
 @njit(cache=True)

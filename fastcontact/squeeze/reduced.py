@@ -424,12 +424,9 @@ def inertia_squeeze_time(D, rho, p0, u_start, h_rms):
 
     Parameters
     ----------
-    D : array_like
-        Block diameter [m].
-    rho : array_like
-        Fluid density [kg/m³].
-    p0 : array_like
-        Squeezing pressure [Pa].
+    D, rho, p0 : array_like
+        As in :func:`inertia_time_constant`: block diameter [m], fluid density [kg/m³],
+        squeezing pressure [Pa].
     u_start : array_like
         Initial film thickness u(0) [m], > h_rms.
     h_rms : array_like
@@ -459,12 +456,9 @@ def inertia_separation(t, u_start, D, rho, p0):
         Time [s], ≥ 0.
     u_start : array_like
         u(0) [m].
-    D : array_like
-        Block diameter [m].
-    rho : array_like
-        Fluid density [kg/m³].
-    p0 : array_like
-        Squeezing pressure [Pa].
+    D, rho, p0 : array_like
+        As in :func:`inertia_time_constant`: block diameter [m], fluid density [kg/m³],
+        squeezing pressure [Pa].
     """
     t = check_positive("t", t, "[s]", allow_zero=True)
     u_start = check_positive("u_start", u_start, "[m]")

@@ -397,10 +397,9 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
     tol = _check_tolerance(tolerance)
     lnp, cols, errs, stats = _refine(psd, grid, theories, _sigma_options(options), tol, refine)
     data, perc_p, zg = _assemble(psd, lnp, cols, theories, options)
-    info = _info(psd, options["gamma"], perc_p, errs, tol, lnp.size, stats, t_start, cal_block)
-    info["tail"] = _tail_samples(psd, float(lnp[0]), theories, _sigma_options(options))
-    info["build_seconds"] = time.perf_counter() - t_start
-    tables = Tables(psd, theories, options, grid, zg, data, info)
+    tail = _tail_samples(psd, float(lnp[0]), theories, _sigma_options(options))
+    tables = Tables(psd, theories, options, grid, zg, data, _info(
+        psd, options["gamma"], perc_p, errs, tol, lnp.size, stats, t_start, cal_block, tail))
     return tables if aniso is None else _with_directional(tables, aniso, t_start)
 
 
@@ -453,15 +452,16 @@ def _tail_samples(psd, lnp_lo, theories, sig_opts):
             "sigma_bar": {th: np.asarray(s)[ok].tolist() for th, s in sig.items()}}
 
 
-def _info(psd, gamma, perc_p, errs, tol, nodes, stats, t_start, cal_block):
+def _info(psd, gamma, perc_p, errs, tol, nodes, stats, t_start, cal_block, tail):
     """The tables' ``info``: asymptote (eq. 3), percolation pressures, midpoint errors,
-    refinement statistics, build time [s] and the calibration block (if any)."""
+    refinement statistics, the tail samples, build time [s] and the calibration block (if
+    any)."""
     u0, beta = asymptote(psd, gamma)
     info = {"asymptote_u0_over_h": u0 / psd.h_rms, "asymptote_beta": beta,
             "percolation_p_over_E": perc_p,
             "interpolation_error": {c: float(e.max()) for c, e in errs.items()},
             "tolerance": tol, "sigma_floor": SIGMA_FLOOR, "nodes": int(nodes), **stats,
-            "build_seconds": time.perf_counter() - t_start}
+            "tail": tail, "build_seconds": time.perf_counter() - t_start}
     if cal_block is not None:
         info["calibration"] = cal_block
     return info
