@@ -107,7 +107,7 @@ def critical_magnification(psd, p, E_star, a_perc=0.5):
     psd : PSD
         Roughness spectrum.
     p : array_like
-        Nominal contact pressure [Pa], > 0.
+        Nominal contact pressure [Pa], > 0, with p/E* >= 1e-150.
     E_star : float or array_like
         Effective modulus [Pa], > 0.
     a_perc : float

@@ -93,7 +93,7 @@ def u1(psd, p, E_star, zeta, gamma=1.0):
     psd : PSD
         Roughness spectrum.
     p : array_like
-        Nominal contact pressure [Pa], > 0.
+        Nominal contact pressure [Pa], > 0, with p/E* >= 1e-150.
     E_star : float or array_like
         Effective modulus [Pa], > 0.
     zeta : array_like

@@ -33,6 +33,7 @@ from numba import njit, prange
 from .._core.validate import check_positive
 from .._core.vocab import DEFAULT_THEORY, column_name
 from .api import register_extension, squeeze_out
+from .model import squeeze_model
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from ._kernels import Cases, Quad, state_gap
@@ -276,7 +277,6 @@ def _scalars(tables, theory, sigma_trap):
     above which σ̄ is below the trap floor (inf: never) [-]; d, cn, g1..g5: the squeeze
     model's σ̄ tail above the top (:data:`~fastcontact.squeeze.model.ModelPar`) [-].
     """
-    from .model import squeeze_model
     key = (id(tables), tables.surface.fingerprint(), theory, sigma_trap,
            repr(tables.info.get("tail")), repr(sorted(tables.options.items())))
     if key in _SC_CACHE:
