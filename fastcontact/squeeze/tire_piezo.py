@@ -30,8 +30,8 @@ from numba import njit, prange
 from ..kernels.quadrature import gauss_legendre
 from ._kernels import Cases, Quad
 from .api import STATUS_NAMES
-from .viscosity import (BarusTargets, _case_head, _integrand, _lnv_of_lnp, _scalars, _segment,
-                        _start, _state, _target_times)
+from .viscosity import (BarusTargets, _case_head, _case_start, _integrand, _lnv_of_lnp,
+                        _scalars, _segment, _state, _target_times)
 
 __all__ = ["QUAD_ORDER", "QUAD_WIDTH", "STATUS", "barus_tire_columns"]
 
@@ -81,61 +81,57 @@ def _exit_w(tab, sc, x0, api, vinf, w0, target, quad):
     return -math.inf
 
 
+@njit(cache=True)
+def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
+    """Case i of :func:`_tire_kernel` into row/column i of ``out`` (:data:`TireOut`).
+
+    Stores go through this (non-parallel) helper: a store made inside a prange body into an
+    array taken from a record argument is silently lost (numba 0.6x parfor lowering)."""
+    T = out.T
+    x0, tau, inside = _case_head(cs, sc, h, i)
+    for k in range(T.shape[0]):
+        T[k, i] = math.nan
+    out.u_exit[i] = math.nan
+    out.u_trap[i] = math.nan
+    out.flf[i] = math.nan
+    out.u_inf[i] = math.nan
+    out.u_start[i] = cs.us[i]
+    if not inside:
+        out.status[i] = _OUT
+        return
+    vinf, vs = _case_start(tab, sc, x0, cs, h, i, out)
+    x_trap = sc[0].x_trap
+    trapped = x0 >= x_trap
+    if trapped:
+        out.status[i] = _TRAPPED
+        out.u_trap[i] = math.exp(_lnv_of_lnp(tab, sc, x_trap)) * h
+        out.flf[i] = -math.expm1(x_trap - x0)
+    else:
+        out.status[i] = _OK
+        out.flf[i] = 0.0
+    if not trapped and not (vs > vinf):
+        out.status[i] = _BELOW
+        return
+    api = alpha[i] * cs.p0[i]
+    lnps, _s = _state(tab, sc, vs)
+    if api * (-math.expm1(lnps - x0)) >= 1.0:
+        out.status[i] = _PIEZO
+        out.flf[i] = math.nan
+        out.u_trap[i] = math.nan
+        return
+    _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
+    w0 = math.log(vs - vinf)
+    w = _exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, quad)
+    out.u_exit[i] = (vinf + math.exp(w)) * h
+
+
 @njit(parallel=True, cache=True)
 def _tire_kernel(tab, sc, cs, alpha, t_fp, h, tg, quad, out):
     """Per case (``cs`` :class:`~fastcontact.squeeze._kernels.Cases`, α [1/Pa] and the
     footprint time t_fp [s] apart): targets (ratios × v∞, then v∞ + dv) and ū at t_fp, SI,
     into ``out`` (:data:`TireOut`)."""
-    # one output field per statement, outside the loop: a record-field setitem in a prange
-    # body is lost (numba 0.6x parfor lowering; see squeeze._fastpath.fast_kernel)
-    T = out.T
-    u_exit = out.u_exit
-    uinf = out.u_inf
-    ustart = out.u_start
-    u_trap = out.u_trap
-    flf = out.flf
-    status = out.status
-    us = cs.us
-    p0 = cs.p0
-    nt = T.shape[0]
-    for i in prange(p0.size):
-        x0, tau, inside = _case_head(cs, sc, h, i)
-        for k in range(nt):
-            T[k, i] = math.nan
-        u_exit[i] = math.nan
-        u_trap[i] = math.nan
-        flf[i] = math.nan
-        uinf[i] = math.nan
-        ustart[i] = us[i]
-        if not inside:
-            status[i] = _OUT
-            continue
-        vinf, vs = _start(tab, sc, x0, us[i], h)
-        uinf[i] = vinf * h
-        ustart[i] = vs * h
-        x_trap = sc[0].x_trap
-        trapped = x0 >= x_trap
-        if trapped:
-            status[i] = _TRAPPED
-            u_trap[i] = math.exp(_lnv_of_lnp(tab, sc, x_trap)) * h
-            flf[i] = -math.expm1(x_trap - x0)
-        else:
-            status[i] = _OK
-            flf[i] = 0.0
-        if not trapped and not (vs > vinf):
-            status[i] = _BELOW
-            continue
-        api = alpha[i] * p0[i]
-        lnps, _s = _state(tab, sc, vs)
-        if api * (-math.expm1(lnps - x0)) >= 1.0:
-            status[i] = _PIEZO
-            flf[i] = math.nan
-            u_trap[i] = math.nan
-            continue
-        _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
-        w0 = math.log(vs - vinf)
-        w = _exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, quad)
-        u_exit[i] = (vinf + math.exp(w)) * h
+    for i in prange(cs.p0.size):
+        _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out)
 
 
 def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_complete,

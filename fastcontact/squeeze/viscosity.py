@@ -156,6 +156,15 @@ def _start(tab, sc, x0, u_start, h):
 
 
 @njit(cache=True)
+def _case_start(tab, sc, x0, cs, h, i, out):
+    """:func:`_start` of case i, also stored [m] into ``out.u_inf[i]`` and ``out.u_start[i]``."""
+    vinf, vs = _start(tab, sc, x0, cs.us[i], h)
+    out.u_inf[i] = vinf * h
+    out.u_start[i] = vs * h
+    return vinf, vs
+
+
+@njit(cache=True)
 def _integrand(tab, sc, x0, api, vinf, w):
     """dt̃/dw at w = ln(v - v∞): (v - v∞)/(σ̄ d g(api d)), d = 1 - π_c/π0; 0 if σ̄ = 0."""
     e = math.exp(w)
@@ -221,47 +230,45 @@ def _case_head(cs, sc, h, i):
     return x0, tau, sc[0].x_min <= x0 <= sc[0].x_max
 
 
+@njit(cache=True)
+def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
+    """Case i of :func:`_piezo_kernel` into row/column i of ``out`` (:data:`BarusOut`).
+
+    Stores go through this (non-parallel) helper: a store made inside a prange body into an
+    array taken from a record argument is silently lost (numba 0.6x parfor lowering)."""
+    T = out.T
+    nt = T.shape[0]
+    x0, tau, inside = _case_head(cs, sc, h, i)
+    out.tau0[i] = tau
+    if not inside:
+        out.status[i] = ST_OUT
+        out.u_inf[i] = math.nan
+        out.u_start[i] = cs.us[i]
+        out.g_start[i] = math.nan
+        for k in range(nt):
+            T[k, i] = math.nan
+        return
+    vinf, vs = _case_start(tab, sc, x0, cs, h, i, out)
+    api = alpha[i] * cs.p0[i]
+    lnps, _s = _state(tab, sc, vs)
+    d_start = -math.expm1(lnps - x0)
+    out.g_start[i] = _rate_factor(api * d_start) if api > 0.0 else 1.0
+    out.status[i] = ST_TRAPPED if x0 >= sc[0].x_trap else ST_OK
+    if api * d_start >= 1.0:
+        out.status[i] = ST_PIEZO
+        for k in range(nt):
+            T[k, i] = math.nan
+        return
+    _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
+
+
 @njit(parallel=True, cache=True)
 def _piezo_kernel(tab, sc, cs, alpha, h, tg, quad, out):
     """Per case (``cs`` :class:`~fastcontact.squeeze._kernels.Cases`, α [1/Pa] apart): targets
     (ratios × v∞, then v∞ + dv) sorted downward, one pass (t̃ → SI) into ``out``
     (:data:`BarusOut`)."""
-    # one output field per statement, outside the loop: a record-field setitem in a prange
-    # body is lost (numba 0.6x parfor lowering; see squeeze._fastpath.fast_kernel)
-    T = out.T
-    uinf = out.u_inf
-    ustart = out.u_start
-    tau0 = out.tau0
-    gstart = out.g_start
-    status = out.status
-    us = cs.us
-    p0 = cs.p0
-    nt = T.shape[0]
-    for i in prange(p0.size):
-        x0, tau, inside = _case_head(cs, sc, h, i)
-        tau0[i] = tau
-        if not inside:
-            status[i] = ST_OUT
-            uinf[i] = math.nan
-            ustart[i] = us[i]
-            gstart[i] = math.nan
-            for k in range(nt):
-                T[k, i] = math.nan
-            continue
-        vinf, vs = _start(tab, sc, x0, us[i], h)
-        uinf[i] = vinf * h
-        ustart[i] = vs * h
-        api = alpha[i] * p0[i]
-        lnps, _s = _state(tab, sc, vs)
-        d_start = -math.expm1(lnps - x0)
-        gstart[i] = _rate_factor(api * d_start) if api > 0.0 else 1.0
-        status[i] = ST_TRAPPED if x0 >= sc[0].x_trap else ST_OK
-        if api * d_start >= 1.0:
-            status[i] = ST_PIEZO
-            for k in range(nt):
-                T[k, i] = math.nan
-            continue
-        _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
+    for i in prange(cs.p0.size):
+        _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out)
 
 
 # =========================================================================== model
