@@ -17,7 +17,7 @@ from numba import njit, prange
 
 from ..tables import k_lnp_of_lnu, k_lnu_of_lnp, k_sigma_of_lnp
 
-__all__ = ["Quad", "Cases", "Targets", "SqOut", "ST_OK", "ST_TRAPPED", "ST_OUT", "ST_BELOW",
+__all__ = ["Quad", "Cases", "Targets", "SqOut", "Film", "ST_OK", "ST_TRAPPED", "ST_OUT", "ST_BELOW",
            "ST_OVERFLOW", "STATUS_NAMES"]
 
 #: Gauss–Legendre rule and panel width in w = ln(v - v_b)
@@ -31,6 +31,9 @@ Targets = namedtuple("Targets", "ratios dvs times")
 #: the times [m], then per case u_inf, u_start, t_relax, u_trap, t_trap [SI],
 #: flf (fluid load fraction), tau0 [s], status (int8)
 SqOut = namedtuple("SqOut", "T U u_inf u_start t_relax u_trap t_trap flf tau0 status")
+#: the film of one case, in units of h_rms: x0 = ln(p0/E*), tau = τ0 [s], vinf = ū∞,
+#: vs = ū at the start, vb = the level it drains to (ū∞, or ū at the trap), trapped (bool)
+Film = namedtuple("Film", "x0 tau vinf vs vb trapped")
 
 # status codes (STATUS_NAMES gives the readable value of the ``status`` column)
 ST_OK, ST_TRAPPED, ST_OUT, ST_BELOW, ST_OVERFLOW = 0, 1, 2, 3, 4
@@ -286,7 +289,7 @@ def _nan_row(out, i, x_out):
 
 @njit(cache=True)
 def _case_state(tab, mp, x0, vs_in, tau, h, i, out):
-    """(v∞, v_start, v_b, trapped) of one case; writes the per-case state columns."""
+    """The :data:`Film` of one case; writes the per-case state columns."""
     vinf = math.exp(_lnv_of_lnp(tab, mp, x0))
     vs = vs_in
     if vs != vs:  # default start: p_cont(v_start) = DEFAULT_P_START p0
@@ -306,12 +309,14 @@ def _case_state(tab, mp, x0, vs_in, tau, h, i, out):
         out.u_trap[i] = math.nan
         out.flf[i] = 0.0
         out.t_relax[i] = tau * vinf * _dlnv_dlnp(tab, mp, x0) / k_sigma_of_lnp(tab, x0)
-    return vinf, vs, vb, trapped
+    return Film(x0, tau, vinf, vs, vb, trapped)
 
 
 @njit(cache=True)
-def _case_targets(tab, mp, x0, vinf, vs, vb, trapped, tg, tau, quad, i, out):
-    """Times to t_star, the ratios and the Δu targets: one downward pass from the start."""
+def _case_targets(tab, mp, film, tg, quad, i, out):
+    """Times to t_star, the ratios and the Δu targets: one downward pass from the start of
+    ``film`` (:data:`Film`)."""
+    x0, tau, vinf, vs, vb, trapped = film
     nt = out.T.shape[0]
     nr = tg.ratios.size
     vts = np.empty(nt)
@@ -356,8 +361,9 @@ def _case_targets(tab, mp, x0, vinf, vs, vb, trapped, tg, tau, quad, i, out):
 
 
 @njit(cache=True)
-def _case_times(tab, mp, x0, vs, vb, trapped, tg, tau, h, quad, i, out):
-    """Trap time and ū at the (ascending) times of row i."""
+def _case_times(tab, mp, film, tg, h, quad, i, out):
+    """Trap time and ū at the (ascending) times of row i (``film``: :data:`Film`)."""
+    x0, tau, vinf, vs, vb, trapped = film
     t_trap = math.inf
     if trapped:
         if vs <= vb:
@@ -390,15 +396,15 @@ def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
         out.u_start[i] = vs_in * h
         out.status[i] = ST_OUT
         return
-    vinf, vs, vb, trapped = _case_state(tab, mp, x0, vs_in, tau, h, i, out)
+    film = _case_state(tab, mp, x0, vs_in, tau, h, i, out)
     # a start at or below ū∞ (trapped rows too), compared as reported (SI): u_start is vs h
-    if not (vs * h > vinf * h):
+    if not (film.vs * h > film.vinf * h):
         _nan_row(out, i, x0)
-        out.u_inf[i] = vinf * h
+        out.u_inf[i] = film.vinf * h
         out.status[i] = ST_BELOW
         return
-    _case_targets(tab, mp, x0, vinf, vs, vb, trapped, tg, tau, quad, i, out)
-    _case_times(tab, mp, x0, vs, vb, trapped, tg, tau, h, quad, i, out)
+    _case_targets(tab, mp, film, tg, quad, i, out)
+    _case_times(tab, mp, film, tg, h, quad, i, out)
 
 
 @njit(parallel=True, cache=True)

@@ -196,7 +196,21 @@ def _lnkappa(pf, mp, vinf):
 
 
 @njit(parallel=True, cache=True)
-def _build_kernel(pf, mp, xn, z0, dz, glx, glw, C, lnv, lnS, zs, sx, lk):
+def _build_kernel(pf, mp, pr, glx, glw):
+    """Fill the rows of ``pr`` (a :data:`Primitive` with its arrays allocated): per x0 node
+    ln v∞, ln κ, ln T and its z-derivatives at the ζ nodes (C), the slope below the grid and
+    the default start's z; ``glx``, ``glw`` the Gauss–Legendre rule of each panel."""
+    # the output arrays as locals, one per statement, outside the loop: a store inside a prange
+    # body into an array taken from a record argument is lost (numba 0.6x parfor lowering)
+    xn = pr.xn
+    C = pr.C
+    lnv = pr.lnv
+    lnS = pr.lnS
+    zs = pr.zs
+    sx = pr.sx
+    lk = pr.lk
+    z0 = pr.z0
+    dz = pr.dz
     for j in prange(xn.size):
         x0 = xn[j]
         lv = _plnv(pf, mp, x0)
@@ -303,11 +317,11 @@ def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, order=NODE_ORDER, check=True):
     z_hi = math.log(mp.v_ext / math.exp(lnv_lo[0]) - 1.0) + lk_max
     nz = int(math.ceil((z_hi - z_lo) / dz)) + 2
     nx = xn.size
-    C = np.empty((nx, nz, 3))
-    lnv, lnS, zs, sx, lk = (np.empty(nx) for _ in range(5))
+    rows = (np.empty(nx) for _ in range(5))  # lnv, lnS, zs, sx, lk
+    pr = Primitive(xn, *_index_map(xn), float(z_lo), float(dz), nz, np.empty((nx, nz, 3)),
+                   *rows, float(mp.v_ext), float(mp.c), float(mp.d))
     glx, glw = gauss_legendre(order)
-    _build_kernel(pf, mp, xn, float(z_lo), float(dz), glx, glw, C, lnv, lnS, zs, sx, lk)
-    pr = Primitive(xn, *_index_map(xn), float(z_lo), float(dz), nz, C, lnv, lnS, zs, sx, lk, float(mp.v_ext), float(mp.c), float(mp.d))
+    _build_kernel(pf, mp, pr, glx, glw)
     info = {"nx": int(nx), "nz": int(nz), "dxi": float(dxi), "build_seconds":
             _clock.perf_counter() - t0}
     if check:
