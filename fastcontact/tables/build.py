@@ -368,9 +368,8 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
     anisotropy : float
         Peklenik number γ_T = ξ_x/ξ_y >= 1 [-] of roughness stretched along x; 1 (default):
         isotropic tables, bit for bit. γ_T > 1 (needs "emt") adds the columns ``<stem>_x``,
-        ``<stem>_y`` of :data:`~fastcontact.flow.anisotropy.DIRECTIONAL_STEMS` (σ̄_xx, σ̄_yy of
-        the anisotropic Bruggeman medium by
-        :func:`~fastcontact.flow.anisotropy.precompute_directional`, with this γ and
+        ``<stem>_y`` of :data:`~fastcontact.flow.anisotropy.DIRECTIONAL_STEMS` (σ̄_xx, σ̄_yy,
+        :func:`~fastcontact.flow.anisotropy.precompute_directional` with this γ and
         emt_threshold), recorded in ``options`` (``anisotropy``, ``anisotropy_form``) and
         ``info["directional"]`` under the metadata digest; the plain "emt" columns stay
         isotropic. Read a direction with ``Tables.conductivity(..., direction=)`` or
