@@ -52,7 +52,8 @@ from fastcontact.flow.conductivity import conductivity  # noqa: E402
 from fastcontact.seal import seal_leak  # noqa: E402
 from fastcontact.seal.viscosity import seal_leak_piezo  # noqa: E402
 from fastcontact.squeeze import squeeze_out  # noqa: E402
-from fastcontact.squeeze.asperity import TIRE_CASE, asperity_levels, plot_asperity_tstar  # noqa: E402
+from fastcontact.figures.asperity_figures import plot_asperity_tstar  # noqa: E402
+from fastcontact.squeeze.asperity import TIRE_CASE, asperity_levels  # noqa: E402
 from fastcontact.squeeze.viscosity import squeeze_out_piezo  # noqa: E402
 from fastcontact.tables.defaults import default_surface  # noqa: E402
 from machine_info import cpu_model  # noqa: E402

@@ -187,7 +187,7 @@ def main():
 
 
 def figures(comps, cals):
-    from fastcontact.validation.figures import _plt
+    from fastcontact.figures.validation_figures import _plt
 
     plt = _plt()
     fig, axs = plt.subplots(len(comps), 3, figsize=(13, 3.3 * len(comps)), squeeze=False,

@@ -158,5 +158,11 @@ def build_parser():
     di.add_argument("--convention", choices=tuple(CONVENTIONS),
                     help="C convention of files that record none")
     from .validation.cli import add_bem_commands  # `fastcontact bem` (issue 13)
-    add_bem_commands(sub)
+    add_bem_commands(sub, _comparison_figure)
     return p
+
+
+def _comparison_figure(comparison, path):
+    """``fastcontact bem compare --figure``: matplotlib is imported on use, by the figures."""
+    from .figures.validation_figures import comparison_figure
+    return comparison_figure(comparison, path)

@@ -126,3 +126,18 @@ def test_summary_matches_levels(psd):
                                    [lv["t_sequential"].iloc[-1], lv["t_parallel"].iloc[-1],
                                     lv["t_star"].iloc[0], lv["t_star"].iloc[-1]], rtol=1e-12)
         assert s["zeta_trap"][i] == lv.attrs["zeta_trap"] == math.inf
+
+
+def test_asperity_figure(levels, tmp_path):
+    """The t*(ζ) figure (in the figures layer) draws every level and both cascade bounds."""
+    from fastcontact.figures.asperity_figures import plot_asperity_tstar
+
+    path = tmp_path / "tstar.png"
+    fig = plot_asperity_tstar({"s": levels}, path, title="t")
+    lines = fig.axes[0].get_lines()
+    ok = ~levels["trapped"].to_numpy()
+    assert np.array_equal(lines[0].get_xdata(), levels["zeta"][ok].to_numpy())
+    assert np.array_equal(lines[0].get_ydata(), levels["t_star"][ok].to_numpy())
+    assert np.array_equal(lines[1].get_ydata(), levels["t_sequential"].to_numpy())
+    assert np.array_equal(lines[2].get_ydata(), levels["t_parallel"].to_numpy())
+    assert path.stat().st_size > 1000

@@ -5,6 +5,7 @@ import io
 import pandas as pd
 import pytest
 
+from fastcontact.figures.validation_figures import comparison_figure
 from fastcontact.validation import Calibration
 from fastcontact.validation.cli import add_bem_commands
 from fastcontact.validation.compare import read_reference
@@ -13,7 +14,7 @@ from fastcontact.validation.compare import read_reference
 def _run(argv):
     p = argparse.ArgumentParser(prog="fastcontact")
     sub = p.add_subparsers(dest="command")
-    add_bem_commands(sub)
+    add_bem_commands(sub, comparison_figure)  # as the main CLI hands it in
     a = p.parse_args(argv)
     out, err = io.StringIO(), io.StringIO()
     code = a.bem_func(a, out, err)

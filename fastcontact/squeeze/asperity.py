@@ -49,7 +49,7 @@ from ..tables import Tables, precompute
 from . import squeeze_out
 
 __all__ = ["TIRE_CASE", "LEVEL_OPTIONS", "asperity_levels", "asperity_summary",
-           "plot_asperity_tstar", "region_radius"]
+           "region_radius"]
 
 #: the paper's Sec. 5 tread block: R = 2 cm, p0 = 0.2 MPa, E = 10 MPa (ν = 0.5), water
 TIRE_CASE = dict(R=0.02, p0=0.2e6, E_star=10e6 / 0.75, eta=1e-3)
@@ -309,32 +309,3 @@ def asperity_summary(tables, *, p0, E_star, R, eta, theory="emt", level_ratio=2.
                       "level_ratio": float(level_ratio), "zetas": zs.tolist(),
                       "level_options": dict(kw), "shape": tuple(shape)})
     return out
-
-
-def plot_asperity_tstar(results, path=None, title=None):
-    """Figure: t*(ζ) of each level and the two cascade bounds, one curve set per surface.
-
-    ``results`` maps a label to a frame of :func:`asperity_levels`. matplotlib is imported
-    here only (optional dependency). Returns the Figure (saved to ``path`` if given).
-    """
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.0, 4.2))
-    for k, (label, df) in enumerate(results.items()):
-        col = f"C{k}"
-        ok = ~df["trapped"].to_numpy()
-        ax.loglog(df["zeta"][ok], df["t_star"][ok], "o-", color=col, label=f"{label}: t*(ζ)")
-        ax.loglog(df["zeta"], df["t_sequential"], "--", color=col, label=f"{label}: Σ t* (sequential)")
-        ax.loglog(df["zeta"], df["t_parallel"], ":", color=col, label=f"{label}: max t* (parallel)")
-        if np.isfinite(df.attrs.get("zeta_trap", np.inf)):
-            ax.axvline(df.attrs["zeta_trap"], color=col, lw=0.8, alpha=0.6)
-    ax.set_xlabel("magnification ζ [-]")
-    ax.set_ylabel("squeeze-out time t* [s]")
-    ax.set_title(title or "asperity-scale squeeze-out (tire tread block, Sec. 5)")
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    if path is not None:
-        fig.savefig(path, dpi=120)
-    return fig

@@ -22,7 +22,6 @@ _SUBMODULE_NAMES = {
     "compare": ("compare_theories", "squeeze_time_ratio", "write_reference", "read_reference"),
     "calibration": ("calibrate", "Calibration"),
     "emt": ("emt_conductivity", "emt_sigma_bar"),
-    "figures": ("comparison_figure",),
 }
 _LAZY = {name: mod for mod, names in _SUBMODULE_NAMES.items() for name in names}
 __all__ = sorted(_LAZY)

@@ -3,7 +3,7 @@
 Hook into the main parser with::
 
     from .validation.cli import add_bem_commands
-    add_bem_commands(sub)                       # in build_parser()
+    add_bem_commands(sub, comparison_figure)    # in build_parser()
     if a.command == "bem": return getattr(a, "bem_func", None)   # in _dispatch()
 
 Every command has the signature ``cmd(args, out, err) -> exit code`` of the main CLI; bad input
@@ -41,8 +41,11 @@ def _ints(text):
             from None
 
 
-def add_bem_commands(subparsers):
-    """Add the ``bem`` command group (``reference``, ``compare``, ``calibrate``)."""
+def add_bem_commands(subparsers, comparison_figure):
+    """Add the ``bem`` command group (``reference``, ``compare``, ``calibrate``).
+
+    ``comparison_figure(frame, path)`` draws ``compare --figure`` (handed in by the main CLI:
+    figures sit above this layer)."""
     b = subparsers.add_parser("bem", help="BEM reference of a surface; compare and calibrate "
                               "the theories against it (needs fastcontact[bem] for 'reference')")
     kw = {}
@@ -79,7 +82,7 @@ def add_bem_commands(subparsers):
     c.add_argument("--calibration", help="calibration file (.toml or .json) to compare as well")
     c.add_argument("-o", "--output", required=True, help="comparison table (.csv or .parquet)")
     c.add_argument("--figure", help="write a figure (PNG/PDF)")
-    c.set_defaults(bem_func=_cmd_compare)
+    c.set_defaults(bem_func=_cmd_compare, bem_figure=comparison_figure)
 
     k = bs.add_parser("calibrate", help="fit γ, α_cj, a_perc and the Bruggeman threshold jointly")
     k.add_argument("reference", help="reference file (.parquet from 'bem reference', or .csv)")
@@ -158,8 +161,7 @@ def _cmd_compare(a, out, err):
         print(f"{label:24s} flow stop theory/BEM = {s['ratio']:.3g}", file=out)
     if a.figure:
         try:
-            from .figures import comparison_figure
-            comparison_figure(cmp, a.figure)
+            a.bem_figure(cmp, a.figure)
         except ImportError as exc:
             print(f"note: {exc}", file=err)
     print(f"wrote {a.output}", file=out)

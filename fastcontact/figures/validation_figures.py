@@ -1,4 +1,5 @@
-"""Figures of a theory-vs-reference comparison (matplotlib, imported only here)."""
+"""Figures of a theory-vs-reference comparison (:func:`fastcontact.validation.compare_theories`;
+the ``--figure`` of ``fastcontact bem compare``)."""
 from __future__ import annotations
 
 import numpy as np
