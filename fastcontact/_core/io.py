@@ -12,25 +12,36 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_path", "write_bytes_atomic"]
+__all__ = ["atomic_path", "write_bytes_atomic", "temp_beside", "publish"]
 
 
-@contextlib.contextmanager
-def atomic_path(path, suffix=".tmp"):
-    """Yield a temporary path beside ``path``; on success it replaces ``path`` atomically.
-
-    The file gets the ordinary permissions (0666 less the umask), not mkstemp's 0600.
-    """
+def temp_beside(path, suffix=".tmp"):
+    """A new empty temporary file beside ``path`` (same folder, hidden name ``.<name>.*``),
+    the folder created if needed; returns its name. :func:`publish` moves it into place."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
     os.close(fd)
+    return tmp
+
+
+def publish(tmp, path):
+    """Give ``tmp`` the ordinary permissions (0666 less the umask, not mkstemp's 0600) and
+    replace ``path`` with it atomically."""
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+    os.replace(tmp, path)
+
+
+@contextlib.contextmanager
+def atomic_path(path, suffix=".tmp"):
+    """Yield a temporary path beside ``path``; on success it replaces ``path`` atomically
+    (:func:`temp_beside`, :func:`publish`)."""
+    tmp = temp_beside(path, suffix)
     try:
         yield tmp
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
+        publish(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)

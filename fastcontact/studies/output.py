@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +11,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
-from .._core.io import atomic_path, write_bytes_atomic
+from .._core.io import atomic_path, publish, temp_beside, write_bytes_atomic
 from .._core.jsonable import json_default
 from .._core.vocab import METADATA_KEY
 from .kinds import column_units
@@ -79,10 +78,7 @@ class ParquetStream:
         self.path = Path(path)
         self.metadata, self.units = metadata, units
         self.writer, self.schema, self.rows = None, None, 0
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, self.tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp",
-                                        dir=self.path.parent)
-        os.close(fd)
+        self.tmp = temp_beside(self.path)
 
     def write(self, df):
         """Append the rows of ``df`` (same columns and types as the first block)."""
@@ -98,10 +94,7 @@ class ParquetStream:
         if self.writer is None:
             raise ValueError(f"{self.path}: no rows were written")
         self.writer.close()
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(self.tmp, 0o666 & ~umask)
-        os.replace(self.tmp, self.path)
+        publish(self.tmp, self.path)
         return self.path
 
     def abort(self):
