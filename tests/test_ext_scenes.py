@@ -100,6 +100,26 @@ def test_tire_alpha_pv(tmp_path):
     assert res.u_exit.iloc[1] > res.u_exit.iloc[0]
 
 
+@pytest.mark.parametrize("kind", ["squeeze", "tire"])
+def test_start_below_equilibrium_explained(tmp_path, kind):
+    """A case that starts at or below ū∞ gets NaN times and an error saying why, with or
+    without a Barus fluid; the other cases of the scene are computed."""
+    st = {"theory": "emt", "p0": "0.2 MPa", "u_start": ["0.1 um", "1 mm"],
+          "alpha_pv": ["0 1/Pa", "2 1/MPa"]}
+    if kind == "tire":
+        st.update({"footprint_length": "10 cm", "speed": "3 m/s"})
+    res = run(scene(kind, st), tmp_path)
+    T, _ = _tables(tmp_path)
+    u_inf = float(tire_footprint(T, p0=2e5, E_star=E_STAR, R=0.01, eta=ETA,
+                                 footprint_length=0.1, speed=3.0, theory="emt")["u_inf"][0])
+    assert 1e-7 < u_inf < 1e-3
+    low = res.u_start.to_numpy() < u_inf
+    assert low.sum() == 2 and (~low).sum() == 2
+    assert res.error[low].str.startswith("start_below_equilibrium").all()
+    assert np.isnan(res.t_star[low]).all()
+    assert (res.error[~low] == "").all() and np.isfinite(res.t_star[~low]).all()
+
+
 @pytest.mark.parametrize("law", ["barus", "roelands"])
 def test_seal_viscosity(tmp_path, law):
     st = dict(SEAL, alpha_pv=["0 1/Pa", "20 1/MPa"], viscosity=law)

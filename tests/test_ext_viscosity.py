@@ -113,6 +113,28 @@ def test_squeeze_piezo_limit_flagged(tables):
     assert np.isnan(df.t_star[1]) and np.isfinite(df.t_star[0])
 
 
+def test_squeeze_start_below_equilibrium_flagged(tables):
+    """A given start at or below ū∞ is one row's status (NaN times), not an error for the
+    batch (issue 11.6); the other rows are what they are alone, and the flagged row's
+    ū∞ is still reported."""
+    kw = dict(E_star=E_STAR, R=0.01, eta=ETA, alpha_pv=2e-6, theory="emt", ratios=(1.1,),
+              du=(1e-7,))
+    good = squeeze_out_piezo(tables, p0=np.array([1e5, 4e5]), **kw)
+    u_inf = good.u_inf.to_numpy()
+    starts = np.array([3.0 * u_inf[0], u_inf[1], 0.5 * u_inf[1]])
+    df = squeeze_out_piezo(tables, p0=np.array([1e5, 4e5, 4e5]), u_start=starts, **kw)
+    assert list(df.status) == ["ok", "start_below_equilibrium", "start_below_equilibrium"]
+    for c in ("t_star", "t_ratio_1.1", "t_du_1e-07", "rate_factor_start"):
+        assert np.all(np.isnan(df[c][1:]))
+    assert np.array_equal(df.u_inf[1:], [u_inf[1], u_inf[1]])
+    alone = squeeze_out_piezo(tables, p0=1e5, u_start=starts[0], **kw)
+    for c in ("u_inf", "t_star", "t_ratio_1.1", "t_du_1e-07", "rate_factor_start"):
+        assert df[c][0] == alone[c][0]
+    ref = squeeze_time(tables, "emt", 1e5, E_STAR, 0.01, ETA, 2e-6, starts[0],
+                       1.1 * u_inf[0], u_inf[0])
+    assert abs(df["t_ratio_1.1"][0] / ref - 1) < 1e-7
+
+
 def test_squeeze_bad_alpha(tables):
     with pytest.raises(ValueError, match="alpha_pv"):
         squeeze_out_piezo(tables, p0=1e5, E_star=E_STAR, R=0.01, eta=ETA, alpha_pv=-1e-8)

@@ -111,6 +111,7 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
         out.flf[i] = 0.0
     if not trapped and not (vs > vinf):
         out.status[i] = _BELOW
+        out.flf[i] = math.nan  # as the base engine: no state computed
         return
     api = alpha[i] * cs.p0[i]
     lnps, _s = _state(tab, sc, vs)

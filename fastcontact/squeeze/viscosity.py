@@ -49,7 +49,9 @@ __all__ = [
 
 #: default start, as in :func:`fastcontact.squeeze.squeeze_out`: p_cont(u_start) = 1e-3 p0
 DEFAULT_P_START = 1e-3
-ST_OK, ST_TRAPPED, ST_OUT, ST_PIEZO = 0, 1, 2, 3
+ST_OK, ST_TRAPPED, ST_OUT, ST_PIEZO, ST_BELOW = 0, 1, 2, 3, 4
+#: readable ``status`` of each code (ST_*)
+STATUS = ("ok", "trapped", "out_of_table", "piezo_limit", "start_below_equilibrium")
 #: targets shared by all cases: ratios ū/ū∞ (t_star's 1.01 first, then the ratio targets) [-]
 #: and dvs = Δu/h_rms of the Δu targets [-]
 BarusTargets = namedtuple("BarusTargets", "ratios dvs")
@@ -249,6 +251,12 @@ def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
             T[k, i] = math.nan
         return
     vinf, vs = _case_start(tab, sc, x0, cs, h, i, out)
+    if not (vs * h > vinf * h):  # a given start at or below ū∞ (as reported, SI)
+        out.status[i] = ST_BELOW
+        out.g_start[i] = math.nan
+        for k in range(nt):
+            T[k, i] = math.nan
+        return
     api = alpha[i] * cs.p0[i]
     lnps, _s = _state(tab, sc, vs)
     d_start = -math.expm1(lnps - x0)
@@ -349,7 +357,9 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
         ``tau0`` [s], ``barus_number`` = α p0 [-], ``rate_factor_start`` g at the start [-],
         flags ``piezo_limit`` (α(p0 - p_cont) >= 1 at the start: NaN times), ``trapped``
         (p0 beyond the trap pressure: targets below ū_trap take inf), ``out_of_table``,
-        ``status`` ("ok", "trapped", "out_of_table", "piezo_limit").
+        ``status`` ("ok", "trapped", "out_of_table", "piezo_limit", "start_below_equilibrium":
+        a given ``u_start`` at or below ū∞, NaN times and rate factor; the other rows are
+        computed).
 
     Notes
     -----
@@ -383,12 +393,6 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     cs = Cases(flat[0], flat[1], flat[2], flat[3], flat[5])
     _piezo_kernel(tables.kernel_data(theory), sc, cs, flat[4], h, BarusTargets(vr, dv),
                   Quad(x, w, width), BarusOut(T, uinf, ustart, tau0, gs, status))
-    if u_start is not None:
-        bad = (status == ST_OK) & ~(flat[5] > uinf)
-        if np.any(bad):
-            i = int(np.flatnonzero(bad)[0])
-            raise ValueError(f"u_start = {flat[5][i]!r} is invalid: must be > u_inf = "
-                             f"{uinf[i]!r} [m]")
     return _piezo_frame(flat, ratios, du, T, uinf, ustart, tau0, gs, status, theory)
 
 
@@ -419,7 +423,7 @@ def _piezo_frame(flat, ratios, du, T, uinf, ustart, tau0, gs, status, theory):
     cols.update({"tau0": tau0, "barus_number": flat[4] * flat[0], "rate_factor_start": gs,
                  "piezo_limit": status == ST_PIEZO, "trapped": status == ST_TRAPPED,
                  "out_of_table": status == ST_OUT,
-                 "status": np.array(["ok", "trapped", "out_of_table", "piezo_limit"])[status]})
+                 "status": np.array(STATUS)[status]})
     df = pd.DataFrame(cols, copy=False)
     units = {"p0": "Pa", "E_star": "Pa", "R": "m", "eta": "Pa s", "alpha_pv": "1/Pa",
              "u_start": "m", "u_inf": "m", "tau0": "s", "barus_number": "1",

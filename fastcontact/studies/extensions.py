@@ -96,7 +96,7 @@ def squeeze_evaluate(tables, rows, theory, fixed, columns, scale, base):
     if "alpha_pv" not in rows:
         return base(tables, rows, theory, fixed, columns, scale)
     from ..squeeze.viscosity import squeeze_out_piezo
-    from .kinds import _out_of_table_errors
+    from .kinds import _below_errors, _out_of_table_errors
 
     def ext(r):
         ratios = tuple(x for x in fixed["ratios"] if column_name("t_ratio", x) in columns)
@@ -110,7 +110,7 @@ def squeeze_evaluate(tables, rows, theory, fixed, columns, scale, base):
         err = _out_of_table_errors(tables, r, sq["out_of_table"].to_numpy(bool))
         pz = _errors(sq["status"], "piezo_limit: alpha_pv (p0 - p_cont) >= 1 at the start: "
                      "no quasi-static squeeze-out (rigid film cannot carry the load)")
-        out["_error"] = np.where(pz != "", pz, err)
+        out["_error"] = _below_errors(sq["status"], np.where(pz != "", pz, err))
         return out
 
     mask = _col(rows, "alpha_pv") > 0.0

@@ -116,6 +116,17 @@ def _out_of_table_errors(tables, rows, oot):
     return err
 
 
+#: why a squeeze row whose engine status is below has NaN outputs
+_BELOW_MESSAGE = ("start_below_equilibrium: u_start <= u_inf (the film starts at or below its "
+                  "equilibrium separation: nothing to squeeze out)")
+
+
+def _below_errors(status, err):
+    """``err`` with the rows of engine status "start_below_equilibrium" explained."""
+    below = np.asarray(status, dtype=object) == "start_below_equilibrium"
+    return np.where(below & (err == ""), _BELOW_MESSAGE, err)
+
+
 # =========================================================================== squeeze
 def squeeze_columns(ratios, du, times) -> list:
     """Result columns of a squeeze study: the engine's catalogue without the inputs it echoes."""
@@ -151,7 +162,8 @@ def _squeeze_base(tables, rows, theory, fixed, columns, scale=1.0):
     for prefix, vals in (("t_ratio", ratios), ("t_du", du), ("u_at", times)):
         for v in vals:
             out[column_name(prefix, v)] = sq[_engine_column(sq, prefix, v)].to_numpy()
-    out["_error"] = _out_of_table_errors(tables, rows, sq["out_of_table"].to_numpy(bool))
+    out["_error"] = _below_errors(sq["status"], _out_of_table_errors(
+        tables, rows, sq["out_of_table"].to_numpy(bool)))
     return out
 
 
@@ -174,10 +186,11 @@ def _tire_evaluate(tables, rows, theory, fixed, columns, scale=1.0):
                         pressure_profile=fixed["pressure_profile"],
                         pressure_model=fixed["pressure_model"], u_start=_col(rows, "u_start"),
                         du_complete=fixed["du_complete"], ratios=fixed["ratios"],
-                        columns=list(dict.fromkeys(list(columns) + ["out_of_table"])),
+                        columns=list(dict.fromkeys(list(columns) + ["out_of_table", "status"])),
                         **_ext.tire_kwargs(rows))
     out = {c: df[c].to_numpy() for c in columns}
-    out["_error"] = _out_of_table_errors(tables, rows, df["out_of_table"].to_numpy(bool))
+    out["_error"] = _below_errors(df["status"], _out_of_table_errors(
+        tables, rows, df["out_of_table"].to_numpy(bool)))
     return out
 
 
