@@ -14,7 +14,8 @@ import numpy as np
 from numba import njit, prange
 
 from . import _kernels as qk
-from .primitive import Primitive, first_row, row_value, stencil, t_of_z, z_of_t
+from ._primitive_eval import inverse_constants, z_of_t_at
+from .primitive import Primitive, first_row, row_value, stencil, t_of_z
 
 __all__ = ["fast_kernel", "history_kernel", "one_case_primitive", "RowTargets", "row_targets"]
 
@@ -162,13 +163,14 @@ def _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, zt):
 
 
 @njit(cache=True, inline="always")
-def _u_at(pr, st, vinf, vs, Ts, tt, h):
-    """ū [m] at the reduced time tt = t/τ0 after the start (T(ū) = T(start) + tt)."""
+def _u_at(pr, st, vinf, vs, Ts, tt, h, ic):
+    """ū [m] at the reduced time tt = t/τ0 after the start (T(ū) = T(start) + tt); ``ic`` the
+    stencil's :func:`~fastcontact.squeeze._primitive_eval.inverse_constants`."""
     if tt == 0.0:
         return vs * h
     if tt == math.inf:
         return vinf * h
-    z = z_of_t(pr, st, vinf, Ts + tt)
+    z = z_of_t_at(pr, st, vinf, Ts + tt, ic)
     # ū(t) <= ū(0): the inverse can land an ulp above the start for t → 0; keeps the ODE's
     # monotonicity (a round-off bound, not a clamp)
     return min(vinf * (1.0 + math.exp(z)), vs) * h
@@ -242,8 +244,10 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
             bad = bad or tk == math.inf
         if nU > 0 and Ts < 0.0:
             Ts = t_of_z(pr, st, vinf, zs)  # the inverse z_of_t pairs with t_of_z
+        ic = inverse_constants(pr, st) if nU > 0 else (0.0, 0.0, 0.0, 0.0, 0.0)
         for k in range(nU):
-            U_out[k, i] = _u_at(pr, st, vinf, vs, Ts, times[k, i if per_case_times else i - i] / tau, h)
+            tt = times[k, i if per_case_times else i - i] / tau
+            U_out[k, i] = _u_at(pr, st, vinf, vs, Ts, tt, h, ic)
         status[i] = qk.ST_OVERFLOW if bad else qk.ST_OK
 
 
@@ -291,6 +295,7 @@ def history_kernel(pr, st, vs_in, tau, h, t, u):
     """ū [m] of one case at the times t [s]; ``pr, st`` from :func:`one_case_primitive`."""
     vinf = math.exp(row_value(pr.lnv, st))
     vs, Ts = _start(pr, st, vinf, vs_in)
+    ic = inverse_constants(pr, st)  # the same for every time of the case
     for k in prange(t.size):
         tk = t[k] / tau
         if tk == 0.0:
@@ -298,4 +303,4 @@ def history_kernel(pr, st, vs_in, tau, h, t, u):
         elif tk == math.inf:
             u[k] = vinf * h
         else:
-            u[k] = min(vinf * (1.0 + math.exp(z_of_t(pr, st, vinf, Ts + tk))), vs) * h
+            u[k] = min(vinf * (1.0 + math.exp(z_of_t_at(pr, st, vinf, Ts + tk, ic))), vs) * h

@@ -17,7 +17,8 @@ from numba import njit
 from ..kernels.hermite import quintic_unit
 from . import _kernels as qk
 
-__all__ = ["Primitive", "first_row", "stencil", "row_value", "row_value_2", "t_of_z", "z_of_t"]
+__all__ = ["Primitive", "first_row", "stencil", "row_value", "row_value_2", "t_of_z", "z_of_t",
+           "z_of_t_at", "inverse_constants"]
 
 #: the tabulated primitive (reduced units). xn (nx) x0 nodes and their locator (blo, bdz,
 #: bidx: fractional row index at uniform x0 samples from blo, step bdz); z0, dz, nz: the z grid; C (nx, nz, 3): ln T, d ln T/dz,
@@ -165,16 +166,35 @@ def t_of_z(pr, st, vinf, z):
 @njit(cache=True, inline="always")
 def z_of_t(pr, st, vinf, T):
     """z = ln(v/v∞ - 1) with T(x0, v) = T (inverse of t_of_z; T = inf gives -inf)."""
+    return z_of_t_at(pr, st, vinf, T, inverse_constants(pr, st))
+
+
+@njit(cache=True, inline="always")
+def inverse_constants(pr, st):
+    """What :func:`z_of_t_at` needs of the stencil st beyond T: (T at v_ext, ln κ, and T0, h0,
+    S of the grid's bottom, :func:`_below`) — computed once for many times of one case."""
+    T0, h0, S = _below(pr, st)
+    return _tail_T(pr, pr.v_ext), row_value(pr.lk, st), T0, h0, S
+
+
+@njit(cache=True, inline="always")
+def z_of_t_at(pr, st, vinf, T, ic):
+    """:func:`z_of_t` with the stencil's :func:`inverse_constants` ``ic`` given."""
+    T_ext, lk, T0, h0, S = ic
     if T == math.inf:
         return -math.inf
     if not (T > 0.0):
         return math.inf
-    if T <= _tail_T(pr, pr.v_ext):
+    if T <= T_ext:
         return math.log(_tail_v(pr, T) / vinf - 1.0)
-    lk = row_value(pr.lk, st)
-    T0, h0, S = _below(pr, st)
     if T >= T0:
-        z = pr.z0 - (T - T0) / h0
+        # T - T0 = g(D), D = z0 - z >= 0, g(D) = S D + (h0 - S)(1 - e^-D): its tangent at 0
+        # (slope h0) and its asymptote (S D + h0 - S) bound D on the same side (below for
+        # h0 > S, g concave; above otherwise): the tighter bound starts a Newton iteration
+        # that then approaches the root monotonically
+        d_tan = (T - T0) / h0
+        d_asy = (T - T0 - (h0 - S)) / S if S > 0.0 else d_tan
+        z = pr.z0 - (max(d_tan, d_asy) if h0 > S else min(d_tan, d_asy))
         for _ in range(30):  # Newton on the analytic part below the grid
             f = T0 + S * (pr.z0 - z) - (h0 - S) * math.expm1(z - pr.z0) - T
             fp = -S - (h0 - S) * math.exp(z - pr.z0)
@@ -199,16 +219,46 @@ def z_of_t(pr, st, vinf, T):
             hi = mid
             y_hi = y_mid
     cf = _cell(pr, st, lo)
+    t = _newton_cell(cf, pr.dz, lt, _inverse_guess(cf, pr.dz, y_lo, y_hi, lt))
+    return pr.z0 + (lo + t) * pr.dz - lk
+
+
+@njit(cache=True, inline="always")
+def _inverse_guess(cf, h, y_lo, y_hi, lt):
+    """Start of the cell's Newton iteration: t at ln T = lt of the cubic Hermite of the inverse
+    t(ln T) from the cell's end values and slopes (error O(h⁴) — about 1e-5 on the default
+    grid), the chord where the slopes do not give a monotone inverse."""
+    if not (y_lo > y_hi):
+        return 0.5
+    s = (y_lo - lt) / (y_lo - y_hi)  # the chord
+    if not (0.0 < s < 1.0):
+        return 0.5
+    dy = cf[3] - cf[0]
+    m0 = dy / (cf[1] * h)  # dt/ds at the ends (s the chord variable)
+    m1 = dy / (cf[4] * h)
+    if not (0.0 < m0 < 3.0 and 0.0 < m1 < 3.0):  # slopes of a monotone cubic (Fritsch–Carlson)
+        return s
+    s2 = s * s
+    s3 = s2 * s
+    t = (s3 - 2.0 * s2 + s) * m0 + (3.0 * s2 - 2.0 * s3) + (s3 - s2) * m1
+    return t if 0.0 < t < 1.0 else s
+
+
+#: a Newton step of at most this (in the cell variable t) ends the iteration, its result taken:
+#: the step after it would be ~ |f''/(2f')| · 1e-16, below the round-off of ln T
+NEWTON_ACCEPT = 1e-8
+
+
+@njit(cache=True, inline="always")
+def _newton_cell(cf, h, lt, t):
+    """t in (0, 1) with the cell's quintic ln T(t) = lt: safeguarded Newton from ``t`` (bisection
+    where a step leaves the bracket). A Newton step <= NEWTON_ACCEPT ends it (quadratic
+    convergence: the result's error is ~ its square); a bracket or bisection step below 1e-13
+    (Δz <= 2.5e-14) ends it too — asking for less than the round-off of ln T
+    (~1e-15 |ln T| / |d ln T/dt|) would only stall the iteration."""
     a, b = 0.0, 1.0
-    # start from the chord, then safeguarded Newton on the combined quintic; |Δt| <= 1e-13
-    # (Δz <= 2.5e-14) ends it: quadratic convergence makes the last step's error far smaller,
-    # and asking for less than the round-off of ln T (~1e-15 |ln T| / |d ln T/dt|) would
-    # only stall the iteration in bisection
-    t = (y_lo - lt) / (y_lo - y_hi) if y_lo > y_hi else 0.5
-    if not (0.0 < t < 1.0):
-        t = 0.5
     for _ in range(60):
-        val, der = _quintic(t, pr.dz, cf)
+        val, der = _quintic(t, h, cf)
         f = val - lt
         if f == 0.0:
             break
@@ -216,14 +266,15 @@ def z_of_t(pr, st, vinf, T):
             a = t
         else:
             b = t
-        tn = t - f / (der * pr.dz) if der != 0.0 else 0.5 * (a + b)
-        if not (a < tn < b):
+        tn = t - f / (der * h) if der != 0.0 else 0.5 * (a + b)
+        newton = a < tn < b
+        if not newton:
             tn = 0.5 * (a + b)
-        if abs(tn - t) <= 1e-13 or b - a <= 1e-13:
-            t = tn
-            break
+        step = abs(tn - t)
         t = tn
-    return pr.z0 + (lo + t) * pr.dz - lk
+        if (newton and step <= NEWTON_ACCEPT) or step <= 1e-13 or b - a <= 1e-13:
+            break
+    return t
 
 
 @njit(cache=True, inline="always")
