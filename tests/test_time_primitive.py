@@ -136,6 +136,33 @@ def test_history_monotone(T, theory):
         assert u[-1] == pytest.approx(floor, rel=1e-12) and np.all(u >= floor * (1 - 1e-12))
 
 
+@pytest.mark.parametrize("theory", ["average", "critical_junction", "emt"])
+def test_inverse_round_trip_every_branch(T, theory):
+    """z_of_t inverts t_of_z in each of its branches — above v_ext (closed-form tail), on the
+    z grid (Newton from the inverse-Hermite start, accepted at a step <= 1e-8) and below the
+    grid (analytic part) — to the round-off of ln T: T(z(T)) = T within 1e-12 and
+    z(T(z)) = z within 1e-9 (|d ln T/dz| >= ~1e-4 here)."""
+    pr = squeeze_model(T, theory).primitive()
+    pr = pr if hasattr(pr, "xn") else pr[0]
+    rng = np.random.default_rng(11)
+    x_hi = min(pr.xn[-1], prim.fast_limit(squeeze_model(T, theory)))
+    hit = set()
+    for x0 in rng.uniform(pr.xn[0], x_hi, 40):
+        st = prim.stencil(pr, x0)
+        vinf = math.exp(prim.row_value(pr.lnv, st))
+        lk = prim.row_value(pr.lk, st)
+        z_ext = math.log(pr.v_ext / vinf - 1.0)
+        for z in np.concatenate([rng.uniform(pr.z0 - lk - 25.0, pr.z0 - lk, 5),
+                                 rng.uniform(pr.z0 - lk, min(z_ext, pr.z0 - lk + (pr.nz - 1) * pr.dz), 20),
+                                 z_ext + rng.uniform(0.01, 3.0, 5)]):
+            t = prim.t_of_z(pr, st, vinf, z)
+            zb = prim.z_of_t(pr, st, vinf, t)
+            assert abs(prim.t_of_z(pr, st, vinf, zb) / t - 1.0) < 1e-12, (x0, z)
+            assert abs(zb - z) < 1e-9, (x0, z, zb)
+            hit.add("tail" if z >= z_ext else "below" if z + lk < pr.z0 else "grid")
+    assert hit == {"tail", "grid", "below"}
+
+
 def test_bad_rows_do_not_sink_the_batch(T):
     lo, hi = T.p_range
     p0 = np.array([1e5, 0.5 * lo * E, 1e5, 2 * hi * E, 1e5])
