@@ -409,9 +409,17 @@ def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
 
 @njit(parallel=True, cache=True)
 def p_of_v_kernel(tab, mp, v, out):
-    """π_c(v) of the model (tables + analytic tail) at reduced separations v."""
+    """π_c(v) of the model (tables + analytic tail) at reduced separations v: the ln π_c of
+    :func:`_state`, without its σ̄ (a history asks for π_c at a million points)."""
+    v_top = mp.v_top
+    x_min = mp.x_min
+    u0 = mp.u0
     for i in prange(v.size):
-        out[i] = math.exp(_state(tab, mp, v[i])[0])
+        vi = v[i]
+        if vi > v_top:
+            out[i] = math.exp(x_min - (vi - v_top) / u0)
+        else:
+            out[i] = math.exp(k_lnp_of_lnu(tab, math.log(vi)))
 
 
 @njit(cache=True)
