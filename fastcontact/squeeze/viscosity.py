@@ -249,41 +249,41 @@ def _case_head(cs, sc, h, i):
 
 
 @njit(cache=True)
+def _no_times(out, i, status):
+    """Row i of ``out`` (:data:`BarusOut`) gets ``status`` and NaN target times."""
+    out.status[i] = status
+    for k in range(out.T.shape[0]):
+        out.T[k, i] = math.nan
+
+
+@njit(cache=True)
 def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
     """Case i of :func:`_piezo_kernel` into row/column i of ``out`` (:data:`BarusOut`).
 
     Stores go through this (non-parallel) helper: a store made inside a prange body into an
     array taken from a record argument is silently lost (numba 0.6x parfor lowering)."""
-    T = out.T
-    nt = T.shape[0]
     x0, tau, inside = _case_head(cs, sc, h, i)
     out.tau0[i] = tau
     if not inside:
-        out.status[i] = ST_OUT
+        _no_times(out, i, ST_OUT)
         out.u_inf[i] = math.nan
         out.u_start[i] = cs.us[i]
         out.g_start[i] = math.nan
-        for k in range(nt):
-            T[k, i] = math.nan
         return
     vinf, vs = _case_start(tab, sc, x0, cs, h, i, out)
     if not (vs * h > vinf * h):  # a given start at or below ū∞ (as reported, SI)
-        out.status[i] = ST_BELOW
+        _no_times(out, i, ST_BELOW)
         out.g_start[i] = math.nan
-        for k in range(nt):
-            T[k, i] = math.nan
         return
     api = alpha[i] * cs.p0[i]
     lnps, _s = _state(tab, sc, vs)
     d_start = -math.expm1(lnps - x0)
     out.g_start[i] = _rate_factor(api * d_start) if api > 0.0 else 1.0
-    out.status[i] = ST_TRAPPED if x0 >= sc[0].x_trap else ST_OK
     if api * d_start >= 1.0:
-        out.status[i] = ST_PIEZO
-        for k in range(nt):
-            T[k, i] = math.nan
+        _no_times(out, i, ST_PIEZO)
         return
-    _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
+    out.status[i] = ST_TRAPPED if x0 >= sc[0].x_trap else ST_OK
+    _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, out.T, i)
 
 
 @njit(parallel=True, cache=True)
