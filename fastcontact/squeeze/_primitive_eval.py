@@ -233,9 +233,10 @@ def _inverse_guess(cf, h, y_lo, y_hi, lt):
     s = (y_lo - lt) / (y_lo - y_hi)  # the chord
     if not (0.0 < s < 1.0):
         return 0.5
-    dy = cf[3] - cf[0]
-    m0 = dy / (cf[1] * h)  # dt/ds at the ends (s the chord variable)
-    m1 = dy / (cf[4] * h)
+    y0, d0, _s0, y1, d1, _s1 = cf
+    dy = y1 - y0
+    m0 = dy / (d0 * h)  # dt/ds at the ends (s the chord variable)
+    m1 = dy / (d1 * h)
     if not (0.0 < m0 < 3.0 and 0.0 < m1 < 3.0):  # slopes of a monotone cubic (Fritsch–Carlson)
         return s
     s2 = s * s
