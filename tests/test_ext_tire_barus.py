@@ -97,3 +97,20 @@ def test_mixed_rows_and_flags(tables):
     assert mix.tau_inertia[2] == base.tau_inertia[2]      # the inertia estimate is unchanged
     with pytest.raises(ValueError, match="alpha_pv"):
         tire_footprint(tables, alpha_pv=-1e-8, **kw)
+
+
+def test_start_below_equilibrium_flagged_trapped_rows_too(tables):
+    """A start at or below ū∞ is status "start_below_equilibrium" with NaN times, also where
+    p0 is beyond the trap pressure — as the base engine (α = 0) says for the same rows."""
+    p_trap = tables.info["percolation_p_over_E"]["emt"] * E_STAR
+    p0 = np.array([0.3 * p_trap, 1.5 * p_trap])
+    kw = dict(p0=p0, E_star=E_STAR, R=R, eta=ETA, footprint_length=0.1, speed=10.0,
+              theory="emt")
+    u_inf = tire_footprint(tables, **kw)["u_inf"].to_numpy()
+    low = dict(kw, u_start=0.5 * u_inf)
+    base = tire_footprint(tables, **low)
+    barus = tire_footprint(tables, alpha_pv=1e-9, **low)
+    assert list(base.status) == ["start_below_equilibrium"] * 2
+    assert list(barus.status) == list(base.status)
+    for c in ("t_star", "t_du", "u_exit", "u_trap", "fluid_load_fraction"):
+        assert np.all(np.isnan(barus[c])) and np.all(np.isnan(base[c])), c

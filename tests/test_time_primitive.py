@@ -141,7 +141,7 @@ def test_inverse_round_trip_every_branch(T, theory):
     """z_of_t inverts t_of_z in each of its branches — above v_ext (closed-form tail), on the
     z grid (Newton from the inverse-Hermite start, accepted at a step <= 1e-8) and below the
     grid (analytic part) — to the round-off of ln T: T(z(T)) = T within 1e-12 and
-    z(T(z)) = z within 1e-9 (|d ln T/dz| >= ~1e-4 here)."""
+    z(T(z)) = z within 1e-11 (|d ln T/dz| >= ~1e-4 here; measured <= 2e-13)."""
     pr = squeeze_model(T, theory).primitive()
     pr = pr if hasattr(pr, "xn") else pr[0]
     rng = np.random.default_rng(11)
@@ -158,7 +158,7 @@ def test_inverse_round_trip_every_branch(T, theory):
             t = prim.t_of_z(pr, st, vinf, z)
             zb = prim.z_of_t(pr, st, vinf, t)
             assert abs(prim.t_of_z(pr, st, vinf, zb) / t - 1.0) < 1e-12, (x0, z)
-            assert abs(zb - z) < 1e-9, (x0, z, zb)
+            assert abs(zb - z) < 1e-11, (x0, z, zb)
             hit.add("tail" if z >= z_ext else "below" if z + lk < pr.z0 else "grid")
     assert hit == {"tail", "grid", "below"}
 

@@ -58,13 +58,20 @@ def tail_sigma(mp, v):
     return y * y2c, v * (1.0 - x * x * dg) * (3.0 * y * y - mp.cn) / (y * y2c)
 
 
+@njit(cache=True, inline="always")
+def _lnp_of_v(tab, mp, v):
+    """ln π_c at separation v [h_rms]: tables, or the eq. (3) tail above v_top."""
+    if v > mp.v_top:
+        return mp.x_min - (v - mp.v_top) / mp.u0
+    return k_lnp_of_lnu(tab, math.log(v))
+
+
 @njit(cache=True)
 def _state(tab, mp, v):
     """(ln π_c, σ̄) at separation v [h_rms]: tables, or the analytic tail above v_top."""
-    v_top = mp.v_top
-    if v > v_top:
-        return mp.x_min - (v - v_top) / mp.u0, tail_sigma(mp, v)[0]
-    lnp = k_lnp_of_lnu(tab, math.log(v))
+    lnp = _lnp_of_v(tab, mp, v)
+    if v > mp.v_top:
+        return lnp, tail_sigma(mp, v)[0]
     if lnp != lnp:
         return lnp, math.nan
     if lnp >= mp.x_trap:
@@ -411,15 +418,8 @@ def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
 def p_of_v_kernel(tab, mp, v, out):
     """π_c(v) of the model (tables + analytic tail) at reduced separations v: the ln π_c of
     :func:`_state`, without its σ̄ (a history asks for π_c at a million points)."""
-    v_top = mp.v_top
-    x_min = mp.x_min
-    u0 = mp.u0
     for i in prange(v.size):
-        vi = v[i]
-        if vi > v_top:
-            out[i] = math.exp(x_min - (vi - v_top) / u0)
-        else:
-            out[i] = math.exp(k_lnp_of_lnu(tab, math.log(vi)))
+        out[i] = math.exp(_lnp_of_v(tab, mp, v[i]))
 
 
 @njit(cache=True)

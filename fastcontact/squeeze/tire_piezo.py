@@ -100,6 +100,9 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
         out.status[i] = _OUT
         return
     vinf, vs = _case_start(tab, sc, x0, cs, h, i, out)
+    if not (vs * h > vinf * h):  # a given start at or below ū∞, trapped rows too (as reported,
+        out.status[i] = _BELOW  # SI; as the base engine and the Barus squeeze-out)
+        return
     x_trap = sc[0].x_trap
     trapped = x0 >= x_trap
     if trapped:
@@ -109,10 +112,6 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
     else:
         out.status[i] = _OK
         out.flf[i] = 0.0
-    if not trapped and not (vs > vinf):
-        out.status[i] = _BELOW
-        out.flf[i] = math.nan  # as the base engine: no state computed
-        return
     api = alpha[i] * cs.p0[i]
     lnps, _s = _state(tab, sc, vs)
     if api * (-math.expm1(lnps - x0)) >= 1.0:
