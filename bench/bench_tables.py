@@ -78,7 +78,14 @@ import fastcontact as fc
 from fastcontact.defaults import default_surface
 from fastcontact.tables import precompute
 name = sys.argv[1]
-psd = fc.SelfAffinePSD(1e-5, 0.8, 1e4, 1e9) if name == "S1" else default_surface(name)
+if name == "S1":
+    psd = fc.SelfAffinePSD(1e-5, 0.8, 1e4, 1e9)
+elif name == "synthetic road":  # a tabulated spectrum: a kink at each of its 48 samples
+    from fastcontact.roaddb import synthetic_road_psd
+    _, q, C = synthetic_road_psd(np.random.default_rng(0))
+    psd = fc.TabulatedPSD(q, C)
+else:
+    psd = default_surface(name)
 precompute(fc.SelfAffinePSD(1e-5, 0.8, 1e4, 1e6))  # numba cache loaded, kernels compiled
 t0, c0 = time.perf_counter(), time.process_time()
 t = precompute(psd)
@@ -98,7 +105,7 @@ def _time_in(pythonpath, name):
 def speed(baseline, repeats):
     """Markdown lines: precompute times here and in ``baseline``, alternating, per surface."""
     here = Path(__file__).resolve().parent.parent
-    names = ["S1"] + sorted(DEFAULT_SURFACES)
+    names = ["S1"] + sorted(DEFAULT_SURFACES) + ["synthetic road"]
     lines = ["## Tables: three-theory precompute time (issue 11.3)", "",
              f"Machine: {machine()}; load average at start {os.getloadavg()[0]:.1f}. Each number "
              f"is the median of {repeats} warm builds (numba cache loaded, kernels compiled), "

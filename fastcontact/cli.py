@@ -224,7 +224,8 @@ def _cmd_tables_defaults(a, out, err):
             raise CLIError("fastcontact tables defaults: not in a source checkout; give the "
                            "folder to write to with -o DIR (the installed package is never "
                            "written)")
-        dirs = [str(checkout / "tables")]
+        # both copies: the package's (what an install loads) and the top-level tables/
+        dirs = [str(checkout / "fastcontact" / "data"), str(checkout / "tables")]
     print(f"building the default tables into {', '.join(dirs)} ...", file=err)
     built = build_default_tables(dirs)
     for name, t in built.items():

@@ -93,8 +93,8 @@ def _add_tables_parser(sub):
     ti.add_argument("--json", action="store_true", help="print the raw metadata as JSON")
     td = tsub.add_parser("defaults", help="rebuild the embedded default tables")
     td.add_argument("-o", "--output-dir", action="append",
-                    help="folder to write to (repeatable; default: ./tables of a source "
-                         "checkout; never the installed package)")
+                    help="folder to write to (repeatable; default: fastcontact/data and "
+                         "tables/ of a source checkout; never an installed package)")
 
 
 def build_parser():

@@ -17,7 +17,8 @@ from scipy import integrate, special
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reference.contact_reference import (  # noqa: E402
-    S1, S1_E_STAR, SPEC8_TABLE, ReferenceSurface, asymptote_closed_form)
+    S1, S1_E_STAR, SPEC8_TABLE, ReferenceSurface, asymptote_closed_form,
+    tabulated_mean_separation)
 
 import fastcontact  # noqa: E402
 from fastcontact import contact  # noqa: E402
@@ -125,6 +126,25 @@ def test_mean_separation_vs_reference(name, gamma):
     u_ref = np.array([ref.mean_separation(x, gamma=gamma) for x in p])
     rel = np.abs(u / u_ref - 1)
     assert np.all(rel < 1e-8), dict(p_over_E=p / E, rel=rel, u=u, u_ref=u_ref)
+
+
+def test_mean_separation_of_a_tabulated_spectrum_vs_reference():
+    """A measured-like spectrum of 41 samples has a kink at every sample, so the quadrature's
+    panels are cut short there (and take fewer nodes); ū and dū/d ln p at A(ζ1)/A0 = 1e-3,
+    0.05, 0.5 against the independent per-segment reference to 1e-10 (measured <= 3e-15)."""
+    q = np.geomspace(1e3, 1e6, 41)
+    C = 1e-22 * (q / 1e3) ** -3.2 * np.exp(0.3 * np.sin(3.0 * np.log(q)))
+    psd = fastcontact.TabulatedPSD(q, C)
+    E = 1e7
+    G1 = 0.25 * math.pi * integrate.quad(lambda lx: math.exp(4 * lx) * float(psd(math.exp(lx))),
+                                         math.log(q[0]), math.log(q[-1]), points=np.log(q[1:-1]),
+                                         epsabs=0, epsrel=1e-13, limit=500)[0]
+    pbar = 2.0 * math.sqrt(G1) * special.erfinv(np.array([1e-3, 0.05, 0.5]))
+    u = np.asarray(contact.mean_separation(psd, pbar * E, E), float)
+    du = np.asarray(contact.separation_slope(psd, pbar * E, E), float)
+    ref = np.array([tabulated_mean_separation(q, C, x) for x in pbar])
+    np.testing.assert_allclose(u, ref[:, 0], rtol=1e-10, atol=0)
+    np.testing.assert_allclose(du, ref[:, 1], rtol=1e-10, atol=0)
 
 
 @pytest.mark.parametrize("name", list(SURFACES))

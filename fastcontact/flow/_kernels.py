@@ -92,7 +92,10 @@ _XGK, _WGK, _WG7 = gauss_kronrod15()
 #: sig = σ̄ of the node (inf: masked) [-], hz = its Almqvist width [h_rms], wk, wg = its
 #: Kronrod and embedded-Gauss weights in A [-]
 _Nodes = namedtuple("_Nodes", "sig hz wk wg")
-#: target relative accuracy of the effective-medium σ̄ (adaptive quadrature in A)
+#: target relative accuracy of the effective-medium σ̄ (adaptive quadrature in A), met by the
+#: Kronrod–Gauss estimate; against tol = 1e-13 the true error was <= 4e-9 on smooth spectra
+#: and up to 3e-8 on tabulated road spectra (u1(A) has a kink where ζq0 crosses each sample,
+#: which the estimate can miss), far inside the tables' σ̄ tolerance (2e-7)
 EMT_TOL = 1e-8
 EMT_MAX_PANELS = 96
 #: grading exponent of the map t -> A that clusters nodes at both ends of [A(ζ1), 1]

@@ -197,7 +197,8 @@ def conductivity(psd, p, E_star, eta, theory=DEFAULT_THEORY, *, gamma=1.0, a_per
     alpha_cj : float
         Critical-junction factor multiplying u1(ζc) [-] (σ carries α_cj³).
     tol : float
-        Target relative accuracy of the adaptive effective-medium integral [-].
+        Target relative accuracy of the adaptive effective-medium integral [-] (its estimate;
+        on tabulated spectra the true error can be up to ~3x larger, see ``EMT_TOL``).
     almqvist : bool
         Gaussian-broadened P(u) (Almqvist et al. 2011, doi:10.1016/j.jmps.2011.08.004).
     emt_threshold : float

@@ -334,6 +334,52 @@ def asymptote_closed_form(h_rms, hurst, q0, gamma=1.0):
 
 
 # SPEC §8 surface S1
+def tabulated_mean_separation(q, C, pbar):
+    """(ū, dū/d ln p) [m] at ζ = 1, γ = 1 and p/E* = pbar of a spectrum tabulated at (q, C)
+    and interpolated as a power law between the samples (a kink at each sample).
+
+    Independent of fastcontact: I(q0, x) per segment in closed form (log1p/expm1, the first
+    segment from δ = x/q0 - 1 so there is no cancellation at the lower limit), the outer
+    integrals by quad per segment (first segment in t = ln δ, the others in ln q):
+    ū = (√π/2) ∫ q²C w E1(s²) dq and dū/d ln p = -√π ∫ q²C w e^{-s²} dq, s = w pbar,
+    w = (π I(q0, q))^{-1/2}.
+    """
+    q = np.asarray(q, dtype=float)
+    C = np.asarray(C, dtype=float)
+    e = np.log(C[1:] / C[:-1]) / np.log(q[1:] / q[:-1])
+
+    def seg_I(i, L):  # ∫ x³C dx from q[i] to q[i] e^L inside segment i
+        k = 4.0 + e[i]
+        pref = C[i] * q[i] ** 4
+        return pref * L if abs(k) < 1e-14 else pref * math.expm1(k * L) / k
+
+    cum = np.concatenate(([0.0], np.cumsum([seg_I(i, math.log(q[i + 1] / q[i]))
+                                            for i in range(e.size)])))
+
+    def terms(x, Ix, i):  # (q²C w E1(s²), q²C w e^{-s²}) at x in segment i
+        Cx = C[i] * (x / q[i]) ** e[i]
+        w = 1.0 / math.sqrt(math.pi * Ix)
+        s2 = (w * pbar) ** 2
+        return x * x * Cx * w * special.exp1(s2), x * x * Cx * w * math.exp(-s2)
+
+    def first(t, j):  # segment 0 in t = ln δ, x = q0 (1 + e^t), dx = q0 e^t dt
+        d = math.exp(t)
+        x = q[0] * (1.0 + d)
+        return terms(x, seg_I(0, math.log1p(d)), 0)[j] * q[0] * d
+
+    def later(lx, i, j):  # segment i >= 1 in ln x
+        x = math.exp(lx)
+        return terms(x, cum[i] + seg_I(i, lx - math.log(q[i])), i)[j] * x
+
+    out = []
+    for j in (0, 1):
+        tot = _quad(lambda t: first(t, j), _T_MIN, math.log(q[1] / q[0] - 1.0))
+        for i in range(1, e.size):
+            tot += _quad(lambda lx: later(lx, i, j), math.log(q[i]), math.log(q[i + 1]))
+        out.append(tot)
+    return 0.5 * math.sqrt(math.pi) * out[0], -math.sqrt(math.pi) * out[1]
+
+
 S1 = dict(h_rms=10e-6, hurst=0.8, q0=1e4, q1=1e9)
 S1_E_STAR = 10e6
 SPEC8_TABLE = [  # p [Pa], A(zeta1)/A0, u/h_rms (gamma=1), u/h_rms (gamma=0.45)
