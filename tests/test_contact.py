@@ -313,3 +313,26 @@ def test_e1_matches_mpmath_to_1e_15():
         assert abs(e1(float(x)) / ref - 1.0) <= 1e-15, x
         assert e1_and_exp(float(x))[1] == math.exp(-float(x))
     assert e1(0.0) == math.inf and e1(800.0) == 0.0
+
+
+def test_narrow_panel_rule_takes_fewer_nodes_only_where_its_bound_allows():
+    """A panel cut short by a kink gets a Gauss–Legendre rule of lower order (numpy's leggauss
+    nodes); a full panel, or a panel setting where 2ρ <= PANEL (the bound does not apply),
+    keeps the given rule."""
+    from fastcontact.contact._kernels import ANALYTIC_RADIUS, _panel_order
+    glx, glw = np.polynomial.legendre.leggauss(10)
+    xs, ws = np.empty(10), np.empty(10)
+    num = 10 * math.log(2 * ANALYTIC_RADIUS / 1.0)
+    assert _panel_order(1.0, 1.0, num, glx, glw, xs, ws) == 10
+    np.testing.assert_array_equal(xs, glx)
+    n = _panel_order(0.13, 1.0, num, glx, glw, xs, ws)
+    assert 2 <= n < 10
+    xr, wr = np.polynomial.legendre.leggauss(n)
+    np.testing.assert_allclose(xs[:n], xr, atol=1e-15)
+    np.testing.assert_allclose(ws[:n], wr, atol=1e-15)
+    # the reduced rule integrates e^x on the narrow panel as well as the full rule does
+    h = 0.5 * 0.13
+    exact = math.exp(h) - math.exp(-h)
+    assert abs(h * np.sum(ws[:n] * np.exp(h * xs[:n])) / exact - 1) < 1e-14
+    big = 10 * math.log(2 * ANALYTIC_RADIUS / 5.0)       # panel = 5 > 2ρ: no reduction
+    assert _panel_order(1.0, 5.0, big, glx, glw, xs, ws) == 10

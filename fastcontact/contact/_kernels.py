@@ -52,18 +52,19 @@ S2_CUT = 64.0
 GRADE = 2.5
 GRADE_MAX = 8.0
 TAU_FLOOR = -300.0
-#: narrow panels (cut short by a kink of the spectrum) take fewer nodes:
-#: Gauss–Legendre with n nodes on a panel of width w errs as (w/2ρ)^(2n) for an integrand
-#: analytic within ρ of the panel (the Bernstein-ellipse bound; L.N. Trefethen, SIAM Rev. 50,
-#: 67 (2008), doi:10.1137/060659831), so n = ceil(n0 ln(2ρ/PANEL)/ln(2ρ/w)) keeps a narrow
-#: panel's bound at that of a full one (n0 nodes, width PANEL). A tabulated spectrum has a kink at every point, so its
-#: panels are mostly narrow. ρ = 2 measured against panels of 0.25 with 20 nodes, on two
-#: synthetic road spectra (47 segments), a 400-point and a 12-point table and two smooth
-#: spectra with a roll-off: the largest errors of ū, dū/d ln p and σ̄ of each spectrum are
-#: unchanged (<= 4e-13 on the tables; 5e-10 and 1e-9 on the smooth two, where both share
-#: them), d²ū/d(ln p)² <= 1e-11 (was 3e-13); single values may move by up to 4e-10 (the
-#: roll-off kink's panels near s0 ~ 1). u1 is 1.75x faster on the road spectra (80 -> 46 us).
-#: ρ = 1.5 was 1.1x faster still but lost ū to 2e-12 on the tables.
+#: narrow panels (cut short by a kink of the spectrum) take fewer nodes: Gauss–Legendre
+#: with n nodes on a panel of width w errs as (w/2ρ)^(2n) for an integrand analytic within ρ
+#: of the panel (the Bernstein-ellipse bound; L.N. Trefethen, SIAM Rev. 50, 67 (2008),
+#: doi:10.1137/060659831), so n = ceil(n0 ln(2ρ/PANEL)/ln(2ρ/w)) keeps a narrow panel's bound
+#: at that of a full one (n0 nodes, width PANEL; only where 2ρ > PANEL). A tabulated spectrum
+#: has a kink at every sample, so its panels are mostly narrow. ρ = 2 measured against panels
+#: of 0.25 with 20 nodes, on two synthetic road spectra (47 segments), a 400-point and a
+#: 12-point table and two smooth spectra with a roll-off: the largest errors of ū, dū/d ln p
+#: and σ̄ of each spectrum are unchanged (<= 4e-13 on the tables; 5e-10 and 1e-9 on the
+#: smooth two, where both share them), d²ū/d(ln p)² <= 1e-11 (was 3e-13); single values may
+#: move by up to 4e-10 (the roll-off kink's panels near s0 ~ 1). u1 is 1.75x faster on the
+#: road spectra (80 -> 46 us). ρ = 1.5 was 1.1x faster still but lost ū to 2e-12 on the
+#: tables.
 ANALYTIC_RADIUS = 2.0
 #: the fewest nodes of a narrow panel
 NARROW_MIN_ORDER = 2
@@ -251,7 +252,7 @@ def _panel_order(width, panel, order_num, glx, glw, xs, ws):
     lower, else the Gauss–Legendre rule of the reduced order."""
     ng = glx.size
     nn = ng
-    if width < panel and ng > NARROW_MIN_ORDER:
+    if width < panel and ng > NARROW_MIN_ORDER and order_num > 0.0:  # (2ρ > panel)
         den = math.log(2.0 * ANALYTIC_RADIUS / width)
         if den > 0.0:
             nn = max(NARROW_MIN_ORDER, int(math.ceil(order_num / den)))
@@ -335,7 +336,8 @@ def separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, out):
                 m = pref3 * l1p if lin3 else pref3 * math.expm1(k3 * l1p) / k3
             else:  # = seg_moment(c[iq], qb[iq], e[iq], 3.0, qb[iq], lr), constants hoisted
                 m = (m_first + cum3[iq] - cum3[ia + 1]
-                     + (seg_pref * lr if abs(seg_k) < 1e-12 else seg_pref * math.expm1(seg_k * lr) / seg_k))
+                     + (seg_pref * lr if abs(seg_k) < 1e-12
+                        else seg_pref * math.expm1(seg_k * lr) / seg_k))
             w = 1.0 / math.sqrt(math.pi * m)
             s0 = w * P
             F, g = f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder)
