@@ -5,7 +5,9 @@ fluid pressure feeding back on the contact pressure, p0 = p_cont + p_f (28).
 
 Flat ring: q = (1/L) ∫_{p0−p_a}^{p0−p_b} σ_eff(p) dp (eq. 33 with uniform p0), from a tabulated
 primitive whose short intervals are integrated directly — never a difference of two large
-primitives; relative error <= 1e-7 against direct quadrature. The tables verify σ̄ only down
+primitives; relative error <= 1e-7 against direct quadrature of the tables' σ̄ (against σ̄ from
+the contact core itself, the tables' interpolation error of σ̄, <= 5e-7, adds: where dp << p0,
+Q is proportional to σ̄(p0)). The tables verify σ̄ only down
 to their floor (``tables.info["sigma_floor"]``): past π_trust, just below the percolation
 pressure ("average" is verified everywhere), σ̄ may be off by orders of magnitude. There Q
 uses the bound 0 <= σ̄ <= σ̄(π_trust) and reports the midpoint when the bound moves Q by less
