@@ -216,16 +216,15 @@ def _cmd_tables_info(a, out, err):
 
 
 def _cmd_tables_defaults(a, out, err):
-    from .tables.defaults import build_default_tables
+    from .tables.defaults import build_default_tables, default_outdirs
     dirs = a.output_dir
     if not dirs:
-        checkout = Path(__file__).resolve().parent.parent
-        if not ((checkout / "pyproject.toml").is_file() and (checkout / "tables").is_dir()):
+        try:
+            dirs = [str(d) for d in default_outdirs()]
+        except ValueError:
             raise CLIError("fastcontact tables defaults: not in a source checkout; give the "
                            "folder to write to with -o DIR (the installed package is never "
-                           "written)")
-        # both copies: the package's (what an install loads) and the top-level tables/
-        dirs = [str(checkout / "fastcontact" / "data"), str(checkout / "tables")]
+                           "written)") from None
     print(f"building the default tables into {', '.join(dirs)} ...", file=err)
     built = build_default_tables(dirs)
     for name, t in built.items():

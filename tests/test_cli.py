@@ -236,3 +236,14 @@ def test_figures_missing_module_fails_loudly(monkeypatch, tmp_path):
         run("figures", "-o", tmp_path)
     assert "fastcontact.figures.nope_figures is missing" in str(exc.value.code)
     assert not list(tmp_path.glob("*.png"))          # fails before making anything
+
+
+def test_tables_defaults_writes_both_copies_in_a_checkout_and_refuses_an_install(monkeypatch):
+    """Without -o it writes the package's copy and tables/ of a source checkout (the freshness
+    test compares the package's copy); an installed package is refused, nothing is built."""
+    from fastcontact.tables import defaults
+    assert [str(d) for d in defaults.default_outdirs()] == [
+        str(ROOT / "fastcontact" / "data"), str(ROOT / "tables")]
+    monkeypatch.setattr(defaults, "SOURCE_CHECKOUT", None)
+    code, out, err = run("tables", "defaults")
+    assert code != 0 and "not in a source checkout" in err and out == ""

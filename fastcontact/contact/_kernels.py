@@ -37,7 +37,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..kernels.quadrature import GL_ORDER, gauss_legendre, seg_moment as _seg_moment
+from ..kernels.quadrature import (GL_ORDER, gauss_legendre, seg_moment as _seg_moment,
+                                  seg_moment_at, seg_moment_constants)
 from ..kernels.special import e1_and_exp, erfinv, k_eval
 
 __all__ = ["PSDKernel", "psd_kernel", "GL_ORDER", "PANEL", "gauss_legendre", "separation_integrals",
@@ -238,13 +239,6 @@ def _tau_lower(qb, c, e, cum3, a, ia, ca, P, tau_hi):
 
 
 @njit(cache=True)
-def _moment_constants(ci, qs, ei):
-    """(pref, k) of :func:`~fastcontact.kernels.quadrature.seg_moment` (n = 3) from the
-    segment's start ``qs``: the third moment from qs to qs e^lr is pref expm1(k lr)/k."""
-    return ci * (qs / qs) ** ei * qs ** 4.0, 3.0 + ei + 1.0
-
-
-@njit(cache=True)
 def _panel_order(width, panel, order_num, glx, glw, xs, ws):
     """Nodes of a panel of ``width`` in τ (:data:`ANALYTIC_RADIUS`), its rule copied into xs, ws.
 
@@ -284,9 +278,7 @@ def separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, out):
     tau_hi = math.log(q1 / a - 1.0)
     ia = seg_index(qb, a)
     # the first (partial) segment's closed-form moment: pref * expm1(k ln(q/a)) / k
-    k3 = 4.0 + e[ia]
-    pref3 = c[ia] * (a / qb[ia]) ** e[ia] * a ** 4
-    lin3 = abs(k3) < 1e-12
+    pref3, k3 = seg_moment_constants(c[ia], qb[ia], e[ia], 3.0, a)
     end_ia = qb[ia + 1]
     lna = math.log(a)
     ca = c[ia] * (a / qb[ia]) ** e[ia]
@@ -307,8 +299,8 @@ def separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, out):
     order_num = ng * math.log(2.0 * ANALYTIC_RADIUS / panel)
     iq = ia  # segment of the current node (nodes increase monotonically)
     lnqb = math.log(qb[ia])
-    seg_pref, seg_k = _moment_constants(c[ia], qb[ia], e[ia])
-    m_first = _seg_moment(c[ia], qb[ia], e[ia], 3.0, a, math.log(end_ia / a))
+    seg_pref, seg_k = seg_moment_constants(c[ia], qb[ia], e[ia], 3.0, qb[ia])
+    m_first = seg_moment_at(pref3, k3, math.log(end_ia / a))  # the whole first segment
     while t0 < tau_hi:
         dist = min(abs(t0 - tau_1), abs(t0))
         width = panel * min(max(1.0, dist / GRADE), GRADE_MAX)
@@ -329,15 +321,13 @@ def separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, out):
             while iq < qb.size - 2 and q > qb[iq + 1]:
                 iq += 1
                 lnqb = math.log(qb[iq])
-                seg_pref, seg_k = _moment_constants(c[iq], qb[iq], e[iq])
+                seg_pref, seg_k = seg_moment_constants(c[iq], qb[iq], e[iq], 3.0, qb[iq])
             lr = lna + l1p - lnqb
             Cq = c[iq] * math.exp(e[iq] * lr)
             if q <= end_ia:
-                m = pref3 * l1p if lin3 else pref3 * math.expm1(k3 * l1p) / k3
-            else:  # = seg_moment(c[iq], qb[iq], e[iq], 3.0, qb[iq], lr), constants hoisted
-                m = (m_first + cum3[iq] - cum3[ia + 1]
-                     + (seg_pref * lr if abs(seg_k) < 1e-12
-                        else seg_pref * math.expm1(seg_k * lr) / seg_k))
+                m = seg_moment_at(pref3, k3, l1p)
+            else:  # the segment's constants hoisted out of seg_moment
+                m = m_first + cum3[iq] - cum3[ia + 1] + seg_moment_at(seg_pref, seg_k, lr)
             w = 1.0 / math.sqrt(math.pi * m)
             s0 = w * P
             F, g = f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder)

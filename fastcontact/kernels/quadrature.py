@@ -17,7 +17,7 @@ from .powerlaw import seg_moment_np
 from .rules import GL_ORDER, QuadRule, gauss_hermite, gauss_legendre
 
 __all__ = ["QuadRule", "gauss_legendre", "gauss_kronrod15", "gauss_hermite", "seg_moment",
-           "seg_moment_np", "GL_ORDER"]
+           "seg_moment_constants", "seg_moment_at", "seg_moment_np", "GL_ORDER"]
 
 _XGK = np.array([-0.991455371120812639206854697526329, -0.949107912342758524526189684047851,
                  -0.864864423359769072789712788640926, -0.741531185599394439863864773280788,
@@ -69,8 +69,20 @@ def seg_moment(ci, qs, ei, n, a, lr):
     lr : float
         ln(upper limit / a) [-]; ``expm1`` keeps the result exact for small ``lr``.
     """
-    k = n + ei + 1.0
-    pref = ci * (a / qs) ** ei * a ** (n + 1.0)
+    pref, k = seg_moment_constants(ci, qs, ei, n, a)
+    return seg_moment_at(pref, k, lr)
+
+
+@njit(cache=True, inline="always")
+def seg_moment_constants(ci, qs, ei, n, a):
+    """(pref, k) of :func:`seg_moment` for the lower limit ``a``: what stays fixed while only
+    the upper limit moves (a quadrature's nodes inside one segment)."""
+    return ci * (a / qs) ** ei * a ** (n + 1.0), n + ei + 1.0
+
+
+@njit(cache=True, inline="always")
+def seg_moment_at(pref, k, lr):
+    """:func:`seg_moment` from its :func:`seg_moment_constants` and lr = ln(upper/a) [-]."""
     if abs(k) < 1e-12:
         return pref * lr
     return pref * math.expm1(k * lr) / k

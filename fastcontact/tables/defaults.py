@@ -29,7 +29,7 @@ from .build import precompute
 from .store import Tables
 
 __all__ = ["DEFAULT_SURFACES", "UnknownDefaultTable", "default_surface", "default_table_path", "load_default_tables",
-           "build_default_tables"]
+           "build_default_tables", "default_outdirs"]
 
 DEFAULT_SURFACES = {
     "asphalt_072mm": dict(h_rms=0.72e-3, hurst=0.8, q0=2 * math.pi / 0.05,
@@ -102,6 +102,17 @@ def load_default_tables(name):
     return Tables.from_parquet(default_table_path(name))
 
 
+def default_outdirs():
+    """The folders :func:`build_default_tables` writes by default: in a source checkout the
+    package's ``fastcontact/data`` (what an install loads) and the repository's ``tables/``;
+    ValueError for an installed package (never written into)."""
+    if SOURCE_CHECKOUT is None:
+        raise ValueError("outdirs = None is invalid for an installed fastcontact: the package "
+                         "folder is not written into; give an output folder (e.g. "
+                         "`fastcontact tables defaults -o DIR`)")
+    return [PACKAGE_DATA, SOURCE_CHECKOUT / "tables"]
+
+
 def build_default_tables(outdirs=None, names=None):
     """Rebuild the default tables and write them (atomically) to every folder in ``outdirs``.
 
@@ -120,11 +131,7 @@ def build_default_tables(outdirs=None, names=None):
         {name: Tables}.
     """
     if outdirs is None:
-        if SOURCE_CHECKOUT is None:
-            raise ValueError("outdirs = None is invalid for an installed fastcontact: the package "
-                             "folder is not written into; give an output folder (e.g. "
-                             "`fastcontact tables defaults -o DIR`)")
-        outdirs = [PACKAGE_DATA, SOURCE_CHECKOUT / "tables"]
+        outdirs = default_outdirs()
     if isinstance(outdirs, (str, Path)):
         outdirs = [outdirs]
     built = {}
