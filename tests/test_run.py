@@ -152,9 +152,9 @@ def test_python_m_fastcontact_and_help_defaults():
     assert "(default: 0.5)" in r.stdout and "percolation threshold" in r.stdout
 
 
-def test_tables_defaults_needs_a_folder_outside_a_checkout(monkeypatch, tmp_path):
-    import fastcontact.cli as c
-    monkeypatch.setattr(c, "__file__", str(tmp_path / "site" / "fastcontact" / "cli.py"))
+def test_tables_defaults_needs_a_folder_outside_a_checkout(monkeypatch):
+    from fastcontact.tables import defaults
+    monkeypatch.setattr(defaults, "SOURCE_CHECKOUT", None)  # as installed (site-packages)
     code, _, err = cli("tables", "defaults")
     assert code == 2 and "-o DIR" in err and "never written" in err
 
