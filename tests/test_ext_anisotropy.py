@@ -113,3 +113,61 @@ def test_table_path(psd):
     sq = fc.squeeze_out(tx, p0=1e5, E_star=E_STAR, R=0.01, eta=1e-3, theory="emt")
     sq_iso = fc.squeeze_out(tables, p0=1e5, E_star=E_STAR, R=0.01, eta=1e-3, theory="emt")
     assert sq.t_star[0] < sq_iso.t_star[0]        # easier flow along the grooves
+
+
+# ------------------------------------------------------------------ adaptive quadrature in A
+@pytest.fixture(scope="module")
+def road_psd():
+    """A measured-style spectrum: a 48-sample table (kinks at every sample in u1(A))."""
+    from fastcontact.surface.roaddb import synthetic_road_psd
+    q, C = synthetic_road_psd(np.random.default_rng(7))[-2:]
+    return fc.TabulatedPSD(q, C)
+
+
+@pytest.mark.parametrize("form", ["self_consistent", "fixed"])
+@pytest.mark.parametrize("which", ["smooth", "road"])
+def test_adaptive_against_fine_fixed_panels(psd, road_psd, form, which):
+    """The default (adaptive, tol 1e-8) against 192 fixed Gauss–Legendre panels of order 10,
+    from light load to past the directional thresholds (σ̄ > 1e-20 compared; closed
+    directions must agree exactly)."""
+    s = psd if which == "smooth" else road_psd
+    pc = float(fc.contact.percolation_pressure(s, E_STAR, 0.5))
+    p = pc * np.geomspace(1e-6, 1.2, 14)
+    ax, ay = directional_sigma_bar(s, p / E_STAR, 3.0, form=form)
+    fx, fy = directional_sigma_bar(s, p / E_STAR, 3.0, form=form, n_panels=192)
+    for a, f in ((ax, fx), (ay, fy)):
+        assert np.array_equal(a > 0, f > 0)
+        m = f > 1e-20
+        np.testing.assert_allclose(a[m], f[m], rtol=3e-8)
+
+
+@pytest.mark.parametrize("form", ["self_consistent", "fixed"])
+def test_fixed_panels_at_gamma_one(psd, form):
+    """The fixed-panel reference (48 panels) forced at γ_T = 1 against the isotropic EMT."""
+    p = np.array([1e-3, 1e2, 1e4, 1e5, 1e6, 1.9e6])
+    iso = conductivity(psd, p, E_STAR, 1.0 / 12.0, "emt", tol=1e-12)[0] / psd.h_rms ** 3
+    sx, sy = directional_sigma_bar(psd, p / E_STAR, 1.0, form=form, n_panels=48)
+    np.testing.assert_allclose(sx, iso, rtol=2e-9)
+    np.testing.assert_allclose(sy, iso, rtol=2e-9)
+
+
+def test_self_consistent_solution_satisfies_its_definition(road_psd):
+    """Λ = γ_T √(σ_yy/σ_xx) with each σ the solution of its own equation at λ = kk Λ^{±1}:
+    checked with Λ from the result and the directional solves redone with brentq."""
+    from scipy.optimize import brentq
+
+    from fastcontact.flow import directional as dmod
+    from fastcontact.flow._anisotropic_kernels import solve_self_consistent
+
+    pc = float(fc.contact.percolation_pressure(road_psd, E_STAR, 0.5))
+    W, sig, A1 = dmod._nodes(road_psd, np.array([1e-4, 0.1, 0.7]) * pc / E_STAR, 1.0, 24)
+    for i in range(A1.size):
+        sx, sy = solve_self_consistent(W[i], sig[i], float(A1[i]), 3.0)
+        lam = 3.0 * math.sqrt(sy / sx)
+        for s, lm in ((sx, lam), (sy, 1.0 / lam)):
+            def f(y):
+                v = math.exp(y)
+                return float(np.sum(W[i] * (1 + lm) * v / (lm * v + sig[i]))
+                             + A1[i] * (1 + lm) / lm - 1)
+            y = brentq(f, math.log(s) - 5, math.log(s) + 5, xtol=1e-14, rtol=1e-15)
+            assert s == pytest.approx(math.exp(y), rel=1e-11)

@@ -13,9 +13,11 @@ import numpy as np
 from numba import njit, prange
 
 from ..contact._kernels import u1_at_area
-from ._kernels import newton_step
+from ..kernels.borrow import borrowed
+from ._kernels import EMT_MAX_PANELS, _area1, emt_panels, emt_split, newton_step
 
-__all__ = ["solve_dir", "solve_self_consistent", "u1_nodes"]
+__all__ = ["solve_dir", "solve_self_consistent", "u1_nodes", "directional_adaptive",
+           "directional_kernel"]
 
 
 @njit(cache=True)
@@ -33,8 +35,11 @@ def _residual(s, W, sig, A1, lam):
 
 
 @njit(cache=True)
-def solve_dir(W, sig, A1, lam):
-    """σ̄ with ∫P (σ - s)/(λ s + σ) = 0 (depolarization 1/(1+λ)); 0 if A1 >= λ/(1+λ)."""
+def solve_dir(W, sig, A1, lam, guess=math.nan):
+    """σ̄ with ∫P (σ - s)/(λ s + σ) = 0 (depolarization 1/(1+λ)); 0 if A1 >= λ/(1+λ).
+
+    Safeguarded Newton in y = ln s, from ``guess`` (ln s of a nearby solution) when it lies
+    inside the bracket, else from the bracket's middle."""
     if A1 >= lam / (1.0 + lam):
         return 0.0
     smax = 0.0
@@ -42,7 +47,7 @@ def solve_dir(W, sig, A1, lam):
         smax = max(smax, sig[j])
     lo = -700.0
     hi = math.log(smax) + 2.0 + math.log(1.0 + 1.0 / lam)
-    y = 0.5 * (lo + hi)
+    y = guess if lo < guess < hi else 0.5 * (lo + hi)
     for _ in range(300):
         f, df = _residual(math.exp(y), W, sig, A1, lam)
         y, lo, hi, done = newton_step(y, f, df, lo, hi)
@@ -51,13 +56,23 @@ def solve_dir(W, sig, A1, lam):
     return math.exp(y)
 
 
+#: the self-consistent iteration ends when its step in ln Λ is below this (relative to
+#: max(1, |ln Λ|)) or its bracket is narrower
+SC_XTOL = 1e-14
+
+
 @njit(cache=True)
 def solve_self_consistent(W, sig, A1, gam, kk=1.0):
-    """(σ̄_xx, σ̄_yy) with Λ = γ √(σ_yy/σ_xx) found by bisection in ln Λ.
+    """(σ̄_xx, σ̄_yy) with Λ = γ √(σ_yy/σ_xx), solved in μ = ln Λ.
 
     The x equation has λ = kk Λ, the y equation λ = kk/Λ; kk = A_c/(1 - A_c) is the odds of
     the tables' effective-medium threshold A_c (1 for the 2-D Bruggeman A_c = 1/2), so both
     close together at A(ζ1)/A0 = A_c (Λ = 1 there) for every γ_T.
+
+    h(μ) = μ - ln γ - ½ (ln σ_yy - ln σ_xx) increases with μ (σ_xx grows and σ_yy falls with
+    Λ, so dh/dμ > 1): secant steps safeguarded by the bracket where both directions are
+    open (bisection where a step leaves it or a direction closes), each directional solve
+    warm-started from the previous one. Ends at a step or bracket below SC_XTOL.
     """
     if A1 >= kk / (1.0 + kk):
         return 0.0, 0.0
@@ -65,26 +80,48 @@ def solve_self_consistent(W, sig, A1, gam, kk=1.0):
     l0 = math.log(A1 / (1.0 - A1)) if A1 > 0.0 else -60.0 - abs(lk)
     lo = l0 - lk
     hi = -l0 + lk
+    lg = math.log(gam)
+    mu = lg if lo < lg < hi else 0.5 * (lo + hi)  # the fixed form's Λ = γ_T
+    gx = math.nan
+    gy = math.nan
+    mu_p = math.nan
+    h_p = math.nan
+    sx = 0.0
+    sy = 0.0
     for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        lam = math.exp(mid)
-        sx = solve_dir(W, sig, A1, kk * lam)
-        sy = solve_dir(W, sig, A1, kk / lam)
-        if sx <= 0.0:
-            lo = mid
-            continue
-        if sy <= 0.0:
-            hi = mid
-            continue
-        h = mid - math.log(gam) - 0.5 * (math.log(sy) - math.log(sx))
-        if h > 0.0:
-            hi = mid
+        sx = solve_dir(W, sig, A1, kk * math.exp(mu), gx)
+        sy = solve_dir(W, sig, A1, kk * math.exp(-mu), gy)
+        if sx <= 0.0 or sy <= 0.0:  # a direction closed: μ outside the open bracket
+            if sx <= 0.0:
+                lo = mu
+            else:
+                hi = mu
+            mu_n = 0.5 * (lo + hi)
+            mu_p = math.nan
         else:
-            lo = mid
-        if hi - lo < 1e-14:
-            return sx, sy
+            gx = math.log(sx)
+            gy = math.log(sy)
+            h = mu - lg - 0.5 * (gy - gx)
+            if h == 0.0:
+                return sx, sy
+            if h > 0.0:
+                hi = mu
+            else:
+                lo = mu
+            # secant through the last two points; the first step takes slope 1 (dh/dμ >= 1)
+            slope = (h - h_p) / (mu - mu_p) if mu_p == mu_p and mu != mu_p else 1.0
+            mu_n = mu - h / slope if slope > 0.0 else 0.5 * (lo + hi)
+            if not (lo < mu_n < hi):
+                mu_n = 0.5 * (lo + hi)
+            mu_p = mu
+            h_p = h
+            if abs(mu_n - mu) <= SC_XTOL * max(1.0, abs(mu)):
+                return sx, sy
+        if hi - lo < SC_XTOL:
+            break
+        mu = mu_n
     lam = math.exp(0.5 * (lo + hi))
-    return solve_dir(W, sig, A1, kk * lam), solve_dir(W, sig, A1, kk / lam)
+    return solve_dir(W, sig, A1, kk * lam, gx), solve_dir(W, sig, A1, kk / lam, gy)
 
 
 @njit(cache=True, parallel=True)
@@ -98,3 +135,122 @@ def u1_nodes(sk, pbar, area, gamma, ktab, glx, glw, panel, out):
         u, _a = u1_at_area(sk, area[i, j], pbar[i], gamma, ktab, glx, glw, panel, work)
         out[i, j] = u
 
+
+
+# ============================================================== adaptive quadrature in A
+@njit(cache=True)
+def _open_nodes(sig, WK, n, Wc, sc):
+    """Wc, sc = the Kronrod weights and σ̄ of the first n nodes, masked nodes (σ̄ = inf: u1
+    undefined) at weight 0 — the (W, σ̄) arrays :func:`solve_dir` reads."""
+    for j in range(n):
+        if sig[j] == math.inf:
+            Wc[j] = 0.0
+            sc[j] = 0.0
+        else:
+            Wc[j] = WK[j]
+            sc[j] = sig[j]
+
+
+@njit(cache=True)
+def _panel_errors(s, lam, sig, WK, WG, npan, pe):
+    """Adds |Kronrod - Gauss| of each panel's share of the residual of direction λ at s,
+    relative to the residual's derivative in ln s, into ``pe``; returns their sum (the
+    direction's relative error estimate of s)."""
+    dfl = 0.0
+    for j in range(15 * npan):
+        sj = sig[j]
+        if sj == math.inf:
+            continue
+        d = lam * s + sj
+        dfl += WK[j] * (1.0 + lam) * (s / d) * (sj / d)
+    if not (dfl > 0.0):
+        return 0.0
+    tot = 0.0
+    for k in range(npan):
+        ek = 0.0
+        eg = 0.0
+        for j in range(15 * k, 15 * k + 15):
+            sj = sig[j]
+            if sj == math.inf:
+                continue
+            t = (1.0 + lam) * s / (lam * s + sj)
+            ek += WK[j] * t
+            eg += WG[j] * t
+        e = abs(ek - eg) / dfl
+        pe[k] += e
+        tot += e
+    return tot
+
+
+@njit(cache=True)
+def directional_adaptive(sk, pbar, ktab, spec, gam, kk, self_consistent):
+    """(σ̄_xx, σ̄_yy, estimated relative error, u1 evaluations) at one reduced pressure with
+    adaptive Gauss–Kronrod panels in A — the nodes, weights and error control of the
+    isotropic :func:`~fastcontact.flow._kernels.emt_sigma` (``spec`` an EMTSpec, whose
+    ``tol`` and ``n_start`` it uses), the solves of :func:`solve_self_consistent`
+    (``self_consistent``) or :func:`solve_dir` with λ = kk γ_T^{±1} ("fixed").
+
+    The panel with the largest error (summed over both open directions, each relative to its
+    residual's derivative in ln σ̄) is halved until the larger of the two directions'
+    estimates is <= tol or EMT_MAX_PANELS is reached."""
+    sk = borrowed(sk)
+    ktab = borrowed(ktab)
+    spec = borrowed(spec)
+    A1 = _area1(sk.cum3, pbar)
+    lx = kk if self_consistent else kk * gam
+    ly = kk if self_consistent else kk / gam
+    if A1 >= lx / (1.0 + lx) and A1 >= ly / (1.0 + ly):
+        return 0.0, 0.0, 0.0, 0
+    pan, npan = emt_panels(sk, pbar, A1, ktab, spec)
+    sig = pan.nodes.sig
+    WK = pan.nodes.wk
+    WG = pan.nodes.wg
+    cap = EMT_MAX_PANELS * 15
+    Wc = np.empty(cap)
+    sc = np.empty(cap)
+    pe = np.empty(EMT_MAX_PANELS)
+    gx = math.nan
+    gy = math.nan
+    while True:
+        n = 15 * npan
+        _open_nodes(sig, WK, n, Wc, sc)
+        if self_consistent:
+            sx, sy = solve_self_consistent(Wc[:n], sc[:n], A1, gam, kk)
+            if sx > 0.0 and sy > 0.0:
+                lam = gam * math.sqrt(sy / sx)
+                lx = kk * lam
+                ly = kk / lam
+        else:
+            sx = solve_dir(Wc[:n], sc[:n], A1, lx, gx)
+            sy = solve_dir(Wc[:n], sc[:n], A1, ly, gy)
+        if not (sx > 0.0 or sy > 0.0):
+            return 0.0, 0.0, 0.0, n
+        gx = math.log(sx) if sx > 0.0 else math.nan
+        gy = math.log(sy) if sy > 0.0 else math.nan
+        for k in range(npan):
+            pe[k] = 0.0
+        est = 0.0
+        if sx > 0.0:
+            est = max(est, _panel_errors(sx, lx, sig, WK, WG, npan, pe))
+        if sy > 0.0:
+            est = max(est, _panel_errors(sy, ly, sig, WK, WG, npan, pe))
+        worst = -1
+        worst_err = 0.0
+        for k in range(npan):
+            if pe[k] > worst_err:
+                worst_err = pe[k]
+                worst = k
+        if est <= spec.tol or npan >= EMT_MAX_PANELS or worst < 0:
+            return sx, sy, est, n
+        npan = emt_split(sk, pbar, A1, ktab, spec, pan, worst, npan)
+
+
+@njit(cache=True, parallel=True)
+def directional_kernel(sk, pbar, ktab, spec, gam, kk, self_consistent, sx, sy, err, nevals):
+    """:func:`directional_adaptive` per reduced pressure into the out arrays."""
+    for i in prange(pbar.size):
+        a, b, e, m = directional_adaptive(sk, pbar[i], ktab, spec, gam, kk, self_consistent)
+        sx[i] = a
+        sy[i] = b
+        err[i] = e
+        nevals[i] = m

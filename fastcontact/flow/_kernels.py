@@ -21,8 +21,8 @@ from ..contact._kernels import m1_above, u1_at_area
 from ..kernels.borrow import borrowed
 from ..kernels.quadrature import gauss_kronrod15
 
-__all__ = ["EMTSpec", "critical_junction_kernel", "emt_kernel", "emt_sigma", "bruggeman",
-           "newton_step", "EMT_TOL", "EMT_MAX_PANELS", "EMT_GRADE"]
+__all__ = ["EMTSpec", "critical_junction_kernel", "emt_kernel", "emt_sigma", "emt_panels",
+           "emt_split", "bruggeman", "newton_step", "EMT_TOL", "EMT_MAX_PANELS", "EMT_GRADE"]
 
 
 class EMTSpec(NamedTuple):
@@ -262,6 +262,42 @@ def _emt_fill_panel(sk, pbar, A1, t0, t1, ktab, spec, work, nodes, off):
             hz[off + k] = 0.0
 
 
+#: the arrays of the adaptive quadrature in A (:func:`emt_panels`): the Kronrod nodes
+#: (:data:`_Nodes`), the panels' ends pt0, pt1 in the graded variable t, u1's work array
+_Panels = namedtuple("_Panels", "nodes pt0 pt1 work")
+
+
+@njit(cache=True)
+def emt_panels(sk, pbar, A1, ktab, spec):
+    """(panels, n): the adaptive quadrature's arrays (room for EMT_MAX_PANELS panels,
+    :data:`_Panels`) with its first n = spec.n_start equal panels in t filled."""
+    cap = EMT_MAX_PANELS * 15
+    pan = _Panels(_Nodes(np.empty(cap), np.zeros(cap), np.empty(cap), np.empty(cap)),
+                  np.empty(EMT_MAX_PANELS), np.empty(EMT_MAX_PANELS), np.empty(4))
+    npan = spec.n_start
+    for k in range(npan):
+        pan.pt0[k] = k / npan
+        pan.pt1[k] = (k + 1) / npan
+        _emt_fill_panel(sk, pbar, A1, pan.pt0[k], pan.pt1[k], ktab, spec, pan.work,
+                        pan.nodes, 15 * k)
+    return pan, npan
+
+
+@njit(cache=True)
+def emt_split(sk, pbar, A1, ktab, spec, pan, worst, npan):
+    """Halve panel ``worst`` of the npan panels of ``pan``: its left half replaces it, the
+    right half is appended (both filled); returns npan + 1."""
+    a0 = pan.pt0[worst]
+    a1 = pan.pt1[worst]
+    am = 0.5 * (a0 + a1)
+    pan.pt1[worst] = am
+    _emt_fill_panel(sk, pbar, A1, a0, am, ktab, spec, pan.work, pan.nodes, 15 * worst)
+    pan.pt0[npan] = am
+    pan.pt1[npan] = a1
+    _emt_fill_panel(sk, pbar, A1, am, a1, ktab, spec, pan.work, pan.nodes, 15 * npan)
+    return npan + 1
+
+
 @njit(cache=True)
 def emt_sigma(sk, pbar, ktab, spec):
     """Bruggeman σ̄ at one reduced pressure with adaptive Gauss–Kronrod panels in A.
@@ -280,20 +316,11 @@ def emt_sigma(sk, pbar, ktab, spec):
     if A1 >= spec.threshold:
         return 0.0, 0.0, 0
     kk = spec.threshold / (1.0 - spec.threshold)
-    cap = EMT_MAX_PANELS * 15
-    sig = np.empty(cap)
-    hz = np.zeros(cap)
-    WK = np.empty(cap)
-    WG = np.empty(cap)
-    pt0 = np.empty(EMT_MAX_PANELS)
-    pt1 = np.empty(EMT_MAX_PANELS)
-    work = np.empty(4)
-    nodes = _Nodes(sig, hz, WK, WG)
-    npan = spec.n_start
-    for k in range(npan):
-        pt0[k] = k / npan
-        pt1[k] = (k + 1) / npan
-        _emt_fill_panel(sk, pbar, A1, pt0[k], pt1[k], ktab, spec, work, nodes, 15 * k)
+    pan, npan = emt_panels(sk, pbar, A1, ktab, spec)
+    sig = pan.nodes.sig
+    hz = pan.nodes.hz
+    WK = pan.nodes.wk
+    WG = pan.nodes.wg
     s = 0.0
     est = 0.0
     while True:
@@ -322,16 +349,7 @@ def emt_sigma(sk, pbar, ktab, spec):
         est = tot / dfl if dfl > 0.0 else 0.0
         if est <= tol or npan >= EMT_MAX_PANELS or worst < 0:
             return s, est, n
-        # split the worst panel: its left half replaces it, the right half is appended
-        a0 = pt0[worst]
-        a1 = pt1[worst]
-        am = 0.5 * (a0 + a1)
-        pt1[worst] = am
-        _emt_fill_panel(sk, pbar, A1, a0, am, ktab, spec, work, nodes, 15 * worst)
-        pt0[npan] = am
-        pt1[npan] = a1
-        _emt_fill_panel(sk, pbar, A1, am, a1, ktab, spec, work, nodes, 15 * npan)
-        npan += 1
+        npan = emt_split(sk, pbar, A1, ktab, spec, pan, worst, npan)
 
 
 @njit(cache=True, parallel=True)

@@ -63,7 +63,7 @@ __all__ = [
 
 def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, direction="x", *,
                       form="self_consistent", gamma=1.0, a_perc=0.5, alpha_cj=1.0,
-                      n_panels=N_PANELS, emt_threshold=0.5):
+                      n_panels=None, emt_threshold=0.5):
     """Directional interfacial conductivity σ_xx or σ_yy [m³/(Pa·s)] by direct quadrature.
 
     Parameters
@@ -88,8 +88,10 @@ def sigma_directional(psd, p, E_star, eta, theory="emt", anisotropy=1.0, directi
     gamma, a_perc, alpha_cj, emt_threshold :
         As in :func:`~fastcontact.flow.conductivity.conductivity` (``a_perc``: the critical
         junction's isotropic threshold; ``emt_threshold``: the effective medium's).
-    n_panels : int
-        Gauss–Legendre panels (order 10) of the P(u) quadrature in A (EMT).
+    n_panels : int or None
+        None (default): the P(u) quadrature in A (EMT) is adaptive (Gauss–Kronrod panels,
+        relative error estimate EMT_TOL); an int: that many fixed Gauss–Legendre panels of
+        order 10 (the reference the adaptive quadrature is tested against).
 
     Returns
     -------
@@ -177,7 +179,7 @@ def _lnsig(sx, sy, lnp, lnp_perc):
     return out
 
 
-def precompute_directional(tables, anisotropy, *, form="self_consistent", n_panels=N_PANELS,
+def precompute_directional(tables, anisotropy, *, form="self_consistent", n_panels=None,
                            tol=1e-6, max_rounds=12, sigma_floor=1e-20):
     """Tabulate σ̄_xx, σ̄_yy (effective medium) of ``tables.surface`` with γ_T = ``anisotropy``.
 
@@ -237,7 +239,8 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
     tab.info.update({"interpolation_error": err, "tolerance": tol, "nodes": int(lnp.size),
                      "refinement_rounds": rounds,
                      "percolation_p_over_E": {d: math.exp(v) for d, v in lnp_perc.items()},
-                     "anisotropy": g, "form": form, "n_panels": int(n_panels),
+                     "anisotropy": g, "form": form,
+                     "n_panels": "adaptive" if n_panels is None else int(n_panels),
                      "emt_threshold": a_c,
                      "build_seconds": time.perf_counter() - t0})
     return tab
@@ -366,7 +369,7 @@ def tables_for_direction(tables, direction, theory=None):
 
 
 def directional_tables(tables, anisotropy=None, direction="x", *, form=None,
-                       directional=None, n_panels=N_PANELS):
+                       directional=None, n_panels=None):
     """A :class:`~fastcontact.tables.Tables` whose "emt" conductivity is σ_xx or σ_yy.
 
     Every engine that reads tables (``squeeze_out``, ``seal_leak``, ``tire_footprint``, the
