@@ -56,9 +56,11 @@ def solve_dir(W, sig, A1, lam, guess=math.nan):
     return math.exp(y)
 
 
-#: the self-consistent iteration ends when its step in ln Λ is below this (relative to
-#: max(1, |ln Λ|)) or its bracket is narrower
+#: the self-consistent iteration ends when |h| (a bound on the error of ln Λ, dh/dμ >= 1) or
+#: its bracket is below this (relative to max(1, |ln Λ|)), or, where round-off in ln σ̄ keeps
+#: |h| above it, when a step is below SC_XTOL/10 with |h| <= SC_HNOISE
 SC_XTOL = 1e-14
+SC_HNOISE = 1e-12
 
 
 @njit(cache=True)
@@ -72,7 +74,8 @@ def solve_self_consistent(W, sig, A1, gam, kk=1.0):
     h(μ) = μ - ln γ - ½ (ln σ_yy - ln σ_xx) increases with μ (σ_xx grows and σ_yy falls with
     Λ, so dh/dμ > 1): secant steps safeguarded by the bracket where both directions are
     open (bisection where a step leaves it or a direction closes), each directional solve
-    warm-started from the previous one. Ends at a step or bracket below SC_XTOL.
+    warm-started from the previous one. Since dh/dμ >= 1, |h| bounds the error of μ: the
+    iteration ends at |h| or a bracket below SC_XTOL (see SC_HNOISE for round-off).
     """
     if A1 >= kk / (1.0 + kk):
         return 0.0, 0.0
@@ -102,7 +105,8 @@ def solve_self_consistent(W, sig, A1, gam, kk=1.0):
             gx = math.log(sx)
             gy = math.log(sy)
             h = mu - lg - 0.5 * (gy - gx)
-            if h == 0.0:
+            scale = max(1.0, abs(mu))
+            if abs(h) <= SC_XTOL * scale:
                 return sx, sy
             if h > 0.0:
                 hi = mu
@@ -115,7 +119,7 @@ def solve_self_consistent(W, sig, A1, gam, kk=1.0):
                 mu_n = 0.5 * (lo + hi)
             mu_p = mu
             h_p = h
-            if abs(mu_n - mu) <= SC_XTOL * max(1.0, abs(mu)):
+            if abs(mu_n - mu) <= 0.1 * SC_XTOL * scale and abs(h) <= SC_HNOISE * scale:
                 return sx, sy
         if hi - lo < SC_XTOL:
             break
