@@ -42,8 +42,10 @@ from scipy.interpolate import CubicSpline
 from .._core.cache import PerObjectCache
 from .._core.validate import check_positive
 from ..contact import area_fraction, percolation_pressure
+from ._kernels import EMT_TOL
 from .conductivity import check_emt_threshold, conductivity
-from .directional import FORMS, N_PANELS, _check, directional_sigma_bar, directional_threshold
+from .directional import (FORMS, N_PANELS, _adaptive, _check, _odds, directional_sigma_bar,
+                          directional_threshold)
 
 __all__ = [
     "FORMS",
@@ -206,8 +208,23 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
     thr = {"x": a_c, "y": a_c} if form == "self_consistent" else \
         {d: directional_threshold(a_c, g, d) for d in ("x", "y")}
     lnp_perc = {d: math.log(float(percolation_pressure(psd, 1.0, thr[d]))) for d in thr}
-    sx, sy = directional_sigma_bar(psd, np.exp(lnp), g, form=form, gamma=gamma,
-                                   n_panels=n_panels, emt_threshold=a_c)
+    quad = {"rule": "adaptive Gauss-Kronrod in A" if n_panels is None
+            else f"{int(n_panels)} Gauss-Legendre panels of order 10 in A"}
+    if n_panels is None:
+        quad.update(tolerance=EMT_TOL, max_error_estimate=0.0, u1_evaluations=0)
+
+    def solve(pb):
+        """(σ̄_xx, σ̄_yy) at p̄ = pb; the adaptive quadrature's worst estimate and u1 count
+        are added up in ``quad``."""
+        if n_panels is not None:
+            return directional_sigma_bar(psd, pb, g, form=form, gamma=gamma,
+                                         n_panels=n_panels, emt_threshold=a_c)
+        a, b, e, m = _adaptive(psd, pb, g, form, gamma, _odds(a_c), EMT_TOL)
+        quad["max_error_estimate"] = max(quad["max_error_estimate"], float(np.max(e)))
+        quad["u1_evaluations"] += int(np.sum(m))
+        return a, b
+
+    sx, sy = solve(np.exp(lnp))
     rounds = 0
     cache = {}                  # exact midpoint values: an unsplit interval keeps its midpoint
     while True:
@@ -217,8 +234,7 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
         xm = 0.5 * (lnp[:-1] + lnp[1:])
         new = np.array([x not in cache for x in xm.tolist()], dtype=bool)
         if np.any(new):
-            nx, ny = directional_sigma_bar(psd, np.exp(xm[new]), g, form=form, gamma=gamma,
-                                           n_panels=n_panels, emt_threshold=a_c)
+            nx, ny = solve(np.exp(xm[new]))
             cache.update(zip(xm[new].tolist(), zip(nx.tolist(), ny.tolist())))
         mx = np.array([cache[x][0] for x in xm.tolist()])
         my = np.array([cache[x][1] for x in xm.tolist()])
@@ -241,6 +257,7 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
                      "percolation_p_over_E": {d: math.exp(v) for d, v in lnp_perc.items()},
                      "anisotropy": g, "form": form,
                      "n_panels": "adaptive" if n_panels is None else int(n_panels),
+                     "quadrature": quad,
                      "emt_threshold": a_c,
                      "build_seconds": time.perf_counter() - t0})
     return tab
