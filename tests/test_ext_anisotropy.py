@@ -171,3 +171,34 @@ def test_self_consistent_solution_satisfies_its_definition(road_psd):
                              + A1[i] * (1 + lm) / lm - 1)
             y = brentq(f, math.log(s) - 5, math.log(s) + 5, xtol=1e-14, rtol=1e-15)
             assert s == pytest.approx(math.exp(y), rel=1e-11)
+
+
+def test_adaptive_on_extreme_cases():
+    """Random spectra (self-affine and road tables), γ_T 1–100, both forms, A_c 0.4–0.6,
+    p̄ from 1e-12 × to 1.6 × the percolation pressure and at it: finite, σ_xx >= σ_yy, closed
+    where the 96-panel reference is closed, within 1e-6 of it where σ̄ > 1e-20 (fixed seed)."""
+    from fastcontact.flow.directional import _adaptive
+    from fastcontact.surface.roaddb import synthetic_road_psd
+
+    rng = np.random.default_rng(20261126)
+    for trial in range(8):
+        if trial % 2:
+            q, C = synthetic_road_psd(np.random.default_rng(int(rng.integers(1 << 30))))[-2:]
+            s = fc.TabulatedPSD(q, C)
+        else:
+            s = fc.SelfAffinePSD(10 ** rng.uniform(-7, -4), rng.uniform(0.3, 0.95),
+                                 10 ** rng.uniform(2, 4), 10 ** rng.uniform(6, 9))
+        g = float(10 ** rng.uniform(0, 2))
+        form = "fixed" if trial % 4 < 2 else "self_consistent"
+        a_c = [0.5, 0.4, 0.6][trial % 3]
+        pc = float(fc.contact.percolation_pressure(s, 1.0, 0.5))
+        pb = pc * np.concatenate((10 ** rng.uniform(-12, 0.2, 10), [0.999, 1.0, 1.001]))
+        sx, sy, _, nev = _adaptive(s, pb, g, form, 1.0, a_c / (1 - a_c), 1e-8)
+        rx, ry = directional_sigma_bar(s, pb, g, form=form, n_panels=96, emt_threshold=a_c)
+        assert np.all(np.isfinite(sx) & np.isfinite(sy) & (sx >= 0) & (sy >= 0))
+        assert np.all(sx >= sy * (1 - 1e-12))
+        assert np.array_equal(sx > 0, rx > 0) and np.array_equal(sy > 0, ry > 0)
+        assert np.all(nev < 96 * 15)
+        for a, r in ((sx, rx), (sy, ry)):
+            m = r > 1e-20
+            np.testing.assert_allclose(a[m], r[m], rtol=1e-6)

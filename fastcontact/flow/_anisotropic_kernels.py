@@ -1,8 +1,11 @@
 """Numba kernels of the anisotropic 2-D Bruggeman medium (directional conductivities).
 
-Reduced units ``σ̄ = 12ησ/h_rms³``; the weights W and node conductivities σ of the u1-based
-P(u) come from :func:`fastcontact.flow.directional._nodes`. Depolarization odds λ: 1 (the
-isotropic medium) or γ_T^{±1}, Λ^{±1} (see :mod:`fastcontact.flow.anisotropy`).
+Reduced units ``σ̄ = 12ησ/h_rms³``. The weights W and node conductivities σ of the u1-based
+P(u) come either from the adaptive Gauss–Kronrod panels of :func:`directional_adaptive` (the
+isotropic effective medium's, :func:`fastcontact.flow._kernels.emt_panels`; the default) or
+from the fixed panels of :func:`fastcontact.flow.directional._nodes` (the reference).
+Depolarization odds λ: 1 (the isotropic medium) or γ_T^{±1}, Λ^{±1} (see
+:mod:`fastcontact.flow.anisotropy`).
 D. Stroud, Phys. Rev. B 12, 3368 (1975), doi:10.1103/PhysRevB.12.3368.
 """
 from __future__ import annotations
