@@ -28,11 +28,7 @@ def _sum_plain(rec):
 
 @njit(cache=True)
 def _sum_borrowed(rec):
-    r = borrowed(rec)
-    s = 0.0
-    for i in range(r.a.size):
-        s += _weighted(r, i)
-    return s
+    return _sum_plain(borrowed(rec))
 
 
 @njit(cache=True)

@@ -17,7 +17,8 @@ from numba import njit, prange
 
 from ..contact._kernels import u1_at_area
 from ..kernels.borrow import borrowed
-from ._kernels import EMT_MAX_PANELS, _area1, emt_panels, emt_split, newton_step
+from ._kernels import (EMT_MAX_PANELS, _area1, emt_panels, emt_split, newton_step, panel_errors,
+                       worst_panel)
 
 __all__ = ["solve_dir", "solve_self_consistent", "u1_nodes", "directional_adaptive",
            "directional_kernel"]
@@ -159,31 +160,16 @@ def _open_nodes(sig, WK, n, Wc, sc):
 
 
 @njit(cache=True)
-def _panel_errors(s, lam, sig, WK, WG, npan, pe):
-    """Adds |Kronrod - Gauss| of each panel's share of the residual of direction λ at s,
-    relative to the residual's derivative in ln s, into ``pe``; returns their sum (the
-    direction's relative error estimate of s)."""
-    dfl = 0.0
-    for j in range(15 * npan):
-        sj = sig[j]
-        if sj == math.inf:
-            continue
-        d = lam * s + sj
-        dfl += WK[j] * (1.0 + lam) * (s / d) * (sj / d)
+def _add_direction(s, lam, pan, npan, spec, pe):
+    """Adds each panel's residual error of the direction with odds λ at s (relative to the
+    residual's derivative in ln s; :func:`~fastcontact.flow._kernels.panel_errors`) into
+    ``pe``; returns their sum, the direction's relative error estimate of s."""
+    dfl = panel_errors(s, lam, pan.nodes, npan, spec, pan.err)
     if not (dfl > 0.0):
         return 0.0
     tot = 0.0
     for k in range(npan):
-        ek = 0.0
-        eg = 0.0
-        for j in range(15 * k, 15 * k + 15):
-            sj = sig[j]
-            if sj == math.inf:
-                continue
-            t = (1.0 + lam) * s / (lam * s + sj)
-            ek += WK[j] * t
-            eg += WG[j] * t
-        e = abs(ek - eg) / dfl
+        e = pan.err[k] / dfl
         pe[k] += e
         tot += e
     return tot
@@ -211,7 +197,6 @@ def directional_adaptive(sk, pbar, ktab, spec, gam, kk, self_consistent):
     pan, npan = emt_panels(sk, pbar, A1, ktab, spec)
     sig = pan.nodes.sig
     WK = pan.nodes.wk
-    WG = pan.nodes.wg
     cap = EMT_MAX_PANELS * 15
     Wc = np.empty(cap)
     sc = np.empty(cap)
@@ -238,15 +223,10 @@ def directional_adaptive(sk, pbar, ktab, spec, gam, kk, self_consistent):
             pe[k] = 0.0
         est = 0.0
         if sx > 0.0:
-            est = max(est, _panel_errors(sx, lx, sig, WK, WG, npan, pe))
+            est = max(est, _add_direction(sx, lx, pan, npan, spec, pe))
         if sy > 0.0:
-            est = max(est, _panel_errors(sy, ly, sig, WK, WG, npan, pe))
-        worst = -1
-        worst_err = 0.0
-        for k in range(npan):
-            if pe[k] > worst_err:
-                worst_err = pe[k]
-                worst = k
+            est = max(est, _add_direction(sy, ly, pan, npan, spec, pe))
+        worst = worst_panel(pe, npan)
         if est <= spec.tol or npan >= EMT_MAX_PANELS or worst < 0:
             return sx, sy, est, n
         npan = emt_split(sk, pbar, A1, ktab, spec, pan, worst, npan)

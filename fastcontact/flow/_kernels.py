@@ -22,7 +22,7 @@ from ..kernels.borrow import borrowed
 from ..kernels.quadrature import gauss_kronrod15
 
 __all__ = ["EMTSpec", "critical_junction_kernel", "emt_kernel", "emt_sigma", "emt_panels",
-           "emt_split", "bruggeman", "newton_step", "EMT_TOL", "EMT_MAX_PANELS", "EMT_GRADE"]
+           "emt_split", "panel_errors", "worst_panel", "bruggeman", "newton_step", "EMT_TOL", "EMT_MAX_PANELS", "EMT_GRADE"]
 
 
 class EMTSpec(NamedTuple):
@@ -263,8 +263,9 @@ def _emt_fill_panel(sk, pbar, A1, t0, t1, ktab, spec, work, nodes, off):
 
 
 #: the arrays of the adaptive quadrature in A (:func:`emt_panels`): the Kronrod nodes
-#: (:data:`_Nodes`), the panels' ends pt0, pt1 in the graded variable t, u1's work array
-_Panels = namedtuple("_Panels", "nodes pt0 pt1 work")
+#: (:data:`_Nodes`), the panels' ends pt0, pt1 in the graded variable t, u1's work array,
+#: the panels' residual errors err (:func:`panel_errors`)
+_Panels = namedtuple("_Panels", "nodes pt0 pt1 work err")
 
 
 @njit(cache=True)
@@ -273,7 +274,8 @@ def emt_panels(sk, pbar, A1, ktab, spec):
     :data:`_Panels`) with its first n = spec.n_start equal panels in t filled."""
     cap = EMT_MAX_PANELS * 15
     pan = _Panels(_Nodes(np.empty(cap), np.zeros(cap), np.empty(cap), np.empty(cap)),
-                  np.empty(EMT_MAX_PANELS), np.empty(EMT_MAX_PANELS), np.empty(4))
+                  np.empty(EMT_MAX_PANELS), np.empty(EMT_MAX_PANELS), np.empty(4),
+                  np.empty(EMT_MAX_PANELS))
     npan = spec.n_start
     for k in range(npan):
         pan.pt0[k] = k / npan
@@ -299,6 +301,37 @@ def emt_split(sk, pbar, A1, ktab, spec, pan, worst, npan):
 
 
 @njit(cache=True)
+def panel_errors(s, kk, nodes, npan, spec, err):
+    """|Kronrod - Gauss| of each of the npan panels' share of the medium's residual at s
+    (depolarization odds kk, terms of :func:`_node_terms`) into err[:npan]; returns
+    Σ W_K d(residual)/d ln s over all nodes, the scale that makes them relative errors of s."""
+    dfl = 0.0
+    for k in range(npan):
+        ek = 0.0
+        eg = 0.0
+        for j in range(15 * k, 15 * k + 15):
+            t1_, t2_ = _node_terms(s, nodes.sig[j], nodes.hz[j], spec.almqvist, spec.ghx,
+                                   spec.ghw, kk)
+            ek += nodes.wk[j] * t1_
+            eg += nodes.wg[j] * t1_
+            dfl += nodes.wk[j] * t2_
+        err[k] = abs(ek - eg)
+    return dfl
+
+
+@njit(cache=True)
+def worst_panel(err, npan):
+    """Index of the largest of err[:npan] (the first of equals); -1 if all are 0."""
+    worst = -1
+    worst_err = 0.0
+    for k in range(npan):
+        if err[k] > worst_err:
+            worst_err = err[k]
+            worst = k
+    return worst
+
+
+@njit(cache=True)
 def emt_sigma(sk, pbar, ktab, spec):
     """Bruggeman σ̄ at one reduced pressure with adaptive Gauss–Kronrod panels in A.
 
@@ -320,7 +353,6 @@ def emt_sigma(sk, pbar, ktab, spec):
     sig = pan.nodes.sig
     hz = pan.nodes.hz
     WK = pan.nodes.wk
-    WG = pan.nodes.wg
     s = 0.0
     est = 0.0
     while True:
@@ -329,24 +361,12 @@ def emt_sigma(sk, pbar, ktab, spec):
         if s <= 0.0:
             return 0.0, 0.0, n
         # per-panel error of the Bruggeman residual, relative to d f / d ln s
-        dfl = 0.0
-        worst = -1
-        worst_err = 0.0
+        dfl = panel_errors(s, kk, pan.nodes, npan, spec, pan.err)
         tot = 0.0
         for k in range(npan):
-            ek = 0.0
-            eg = 0.0
-            for j in range(15 * k, 15 * k + 15):
-                t1_, t2_ = _node_terms(s, sig[j], hz[j], almqvist, ghx, ghw, kk)
-                ek += WK[j] * t1_
-                eg += WG[j] * t1_
-                dfl += WK[j] * t2_
-            err = abs(ek - eg)
-            tot += err
-            if err > worst_err:
-                worst_err = err
-                worst = k
+            tot += pan.err[k]
         est = tot / dfl if dfl > 0.0 else 0.0
+        worst = worst_panel(pan.err, npan)
         if est <= tol or npan >= EMT_MAX_PANELS or worst < 0:
             return s, est, n
         npan = emt_split(sk, pbar, A1, ktab, spec, pan, worst, npan)
