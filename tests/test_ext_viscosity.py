@@ -108,9 +108,18 @@ def test_squeeze_alpha_zero_is_base(tables, theory):
     kw = dict(p0=np.array([2e4, 1e5, 4e5]), E_star=E_STAR, R=0.01, eta=ETA, theory=theory,
               ratios=(1.1, 1.001))
     a = squeeze_out(tables, method="quad", **kw)
-    b = squeeze_out_piezo(tables, alpha_pv=0.0, **kw)
+    b = squeeze_out_piezo(tables, alpha_pv=0.0, method="quad", **kw)
     for c in ("u_start", "u_inf", "t_star", "t_ratio_1.1", "t_ratio_1.001"):
         np.testing.assert_allclose(b[c], a[c], rtol=1e-12)
+    # the fast path at α = 0: the base primitive's numbers (its start and ū∞ exactly; the
+    # times from t_of_z at both ends instead of the row tables: within the primitive's error)
+    a = squeeze_out(tables, method="fast", **kw)
+    b = squeeze_out_piezo(tables, alpha_pv=0.0, method="fast", **kw)
+    assert b.attrs["method"] == "fast" and set(b.status) == {"ok"}
+    for c in ("u_start", "u_inf"):
+        np.testing.assert_array_equal(b[c], a[c])
+    for c in ("t_star", "t_ratio_1.1", "t_ratio_1.001"):
+        np.testing.assert_allclose(b[c], a[c], rtol=1e-8)
 
 
 @pytest.mark.parametrize("p0,alpha", [(1e5, 3e-6), (4e5, 2e-6)])
@@ -219,8 +228,13 @@ def test_squeeze_out_keyword(tables):
     got = squeeze_out(tables, alpha_pv=2e-6, **kw)
     ref = squeeze_out_piezo(tables, alpha_pv=2e-6, **kw)
     assert got.equals(ref)
+    # ū at times: the Barus engine's u_at columns [m]
+    got = squeeze_out(tables, alpha_pv=2e-6, times=(0.0, 1e-3), **kw)
+    assert got.attrs["units"]["u_at_0.001"] == "m"
+    np.testing.assert_array_equal(got["u_at_0"], got.u_start)
+    assert np.all(got["u_at_0.001"] < got.u_start) and np.all(got["u_at_0.001"] > got.u_inf)
     with pytest.raises(ValueError, match="times"):
-        squeeze_out(tables, alpha_pv=2e-6, times=(1e-3,), **kw)
+        squeeze_out(tables, alpha_pv=2e-6, times=(-1e-3,), **kw)
 
 
 def test_seal_leak_keyword(tables):

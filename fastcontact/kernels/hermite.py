@@ -10,7 +10,17 @@ from numba import njit
 
 from ._index import clamp_index
 
-__all__ = ["cubic_uniform", "quintic_interval", "quintic_unit", "quintic_np"]
+__all__ = ["cubic_basis", "cubic_uniform", "quintic_interval", "quintic_unit", "quintic_np"]
+
+
+@njit(cache=True, inline="always")
+def cubic_basis(t, h):
+    """Cubic Hermite basis at t = (x - x0)/h in [0, 1] on an interval of width h: the weights
+    (h00, h10, h01, h11) of y0, d0, y1, d1 (d the derivatives in x)."""
+    t2 = t * t
+    t3 = t2 * t
+    return (2.0 * t3 - 3.0 * t2 + 1.0, (t3 - 2.0 * t2 + t) * h, -2.0 * t3 + 3.0 * t2,
+            (t3 - t2) * h)
 
 
 @njit(cache=True)

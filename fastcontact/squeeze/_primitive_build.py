@@ -15,6 +15,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, prange
 
+from ..kernels.hermite import cubic_basis
 from ..kernels.quadrature import gauss_legendre
 from . import _kernels as qk
 from ._primitive_eval import Primitive, _index_map, row_value, stencil, t_of_z
@@ -88,11 +89,7 @@ def _pstate(pf, mp, v):
     t = u - i
     h = pf.ds
     t2 = t * t
-    t3 = t2 * t
-    h00 = 2.0 * t3 - 3.0 * t2 + 1.0
-    h10 = (t3 - 2.0 * t2 + t) * h
-    h01 = -2.0 * t3 + 3.0 * t2
-    h11 = (t3 - t2) * h
+    h00, h10, h01, h11 = cubic_basis(t, h)
     g00 = (6.0 * t2 - 6.0 * t) / h
     g10 = 3.0 * t2 - 4.0 * t + 1.0
     g11 = 3.0 * t2 - 2.0 * t

@@ -124,6 +124,7 @@ class SqueezeModel:
         self.v_top, self.u0, self.c_tail, self.d_tail = v_top, u0, c, d
         self.tail = tail
         self._prim = None
+        self._barus = None
         self._lock = threading.Lock()
         self.setup_seconds = _clock.perf_counter() - t_start
 
@@ -151,6 +152,16 @@ class SqueezeModel:
             if self._prim is None:
                 self._prim = prim.load_or_build(self, cache_dir)
             return self._prim
+
+    def barus_table(self):
+        """(table, info) of the Barus correction beside the primitive (built on first use,
+        5-20 ms, kept in memory; :mod:`._barus_primitive`)."""
+        pr = self.primitive()
+        with self._lock:
+            if self._barus is None:
+                from . import _barus_primitive
+                self._barus = _barus_primitive.build(self, pr)
+            return self._barus
 
     def p_of_v(self, v):
         """π_c(v) of the model (tables + analytic tail) at reduced separations v [-]."""

@@ -192,7 +192,7 @@ def _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
         return barus_tire_columns(
             tables, b, p_eval, t_fp, theory, ratios, _ratio_names(ratios), du_complete,
             b["alpha_pv"], out, lambda tb, bb, pe, tf, o: _squeeze_columns(
-                tb, bb, pe, tf, theory, ratios, du_complete, method, o))
+                tb, bb, pe, tf, theory, ratios, du_complete, method, o), method)
     return _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out)
 
 
@@ -266,10 +266,12 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
         Squeeze-out engine (None: :func:`squeeze_method` of the case count).
     alpha_pv : array_like, default 0.0
         Barus pressure–viscosity coefficient α [1/Pa] >= 0, η = η0 exp(α p_f) (issue 14).
-        Rows with α > 0 run :mod:`fastcontact.squeeze.tire_piezo` (exact reduced-pressure
-        rate factor, quadrature in ln(ū − ū∞); ``method`` does not apply to them; status
-        "piezo_limit" with NaN results where α(p_eval − p_cont(ū(0))) >= 1); rows with
-        α = 0 are the base engine's, bit for bit.
+        Rows with α > 0 run the Barus engine (exact reduced-pressure rate factor): with
+        ``method="fast"`` the time primitive plus the tabulated Barus correction
+        (:mod:`fastcontact.squeeze._barus_fast`; rows with α p_eval > 0.6 or next to the
+        trap pressure by quadrature in the same pass), with "quad" the per-case quadrature
+        of :mod:`fastcontact.squeeze.tire_piezo`; status "piezo_limit" with NaN results where
+        α(p_eval − p_cont(ū(0))) >= 1. Rows with α = 0 are the base engine's, bit for bit.
 
     Returns
     -------

@@ -30,8 +30,8 @@ from numba import njit, prange
 from ..kernels.quadrature import gauss_legendre
 from ._kernels import Cases, Quad
 from .api import STATUS_NAMES
-from .viscosity import (BarusTargets, _case_head, _case_start, _integrand, _lnv_of_lnp,
-                        _scalars, _segment, _state, _target_times)
+from .viscosity import (BarusTargets, _case_head, _case_start, _lnv_of_lnp, _scalars,
+                        _state, _target_times, exit_w, fast_scratch, fast_setup)
 
 __all__ = ["QUAD_ORDER", "QUAD_WIDTH", "STATUS", "barus_tire_columns"]
 
@@ -42,43 +42,9 @@ STATUS = tuple(STATUS_NAMES) + ("piezo_limit",)
 _OK, _TRAPPED, _OUT, _BELOW = (STATUS.index(s) for s in ("ok", "trapped", "out_of_table",
                                                          "start_below_equilibrium"))
 _PIEZO = STATUS.index("piezo_limit")
-#: the exit search stops this far below ln(ū(0) − ū∞) (ū is then ū∞ to round-off)
-W_SPAN = 60.0
 #: outputs of the Barus tire kernel, one column per row: T (nt, n) target times [s], u_exit,
 #: u_inf, u_start, u_trap [m], flf (fluid load fraction) [-], status (int8)
 TireOut = namedtuple("TireOut", "T u_exit u_inf u_start u_trap flf status")
-
-
-@njit(cache=True)
-def _exit_w(tab, sc, x0, api, vinf, w0, target, quad):
-    """w = ln(v − v∞) reached after reduced time ``target`` from w0 (-inf: beyond W_SPAN)."""
-    width = quad.width
-    t = 0.0
-    w = w0
-    while w > w0 - W_SPAN:
-        wn = w - width
-        dt = _segment(tab, sc, x0, api, vinf, wn, w, quad)
-        if t + dt >= target:
-            lo = wn
-            hi = w
-            y = 0.5 * (lo + hi)
-            for _ in range(100):
-                f = t + _segment(tab, sc, x0, api, vinf, y, w, quad) - target
-                if f > 0.0:
-                    lo = y
-                else:
-                    hi = y
-                dtdw = _integrand(tab, sc, x0, api, vinf, y)
-                yn = y + f / dtdw if dtdw < math.inf else 0.5 * (lo + hi)
-                if not (lo < yn < hi):
-                    yn = 0.5 * (lo + hi)
-                if abs(yn - y) <= 1e-14 * max(1.0, abs(y)) or hi - lo <= 1e-14 * max(1.0, abs(y)):
-                    return yn
-                y = yn
-            return y
-        t += dt
-        w = wn
-    return -math.inf
 
 
 @njit(cache=True)
@@ -121,7 +87,7 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
         return
     _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
     w0 = math.log(vs - vinf)
-    w = _exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, quad)
+    w = exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, quad)
     out.u_exit[i] = (vinf + math.exp(w)) * h
 
 
@@ -135,7 +101,7 @@ def _tire_kernel(tab, sc, cs, alpha, t_fp, h, tg, quad, out):
 
 
 def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_complete,
-                       alpha, out, base_columns):
+                       alpha, out, base_columns, method="fast"):
     """Fill the squeeze-out columns of :func:`~fastcontact.squeeze.tire.tire_footprint` with
     a Barus fluid (α = ``alpha`` [1/Pa] per row) into ``out``; rows with α = 0 go to
     ``base_columns(tables, b_subset, p_eval_subset, t_fp_subset, out_subset)`` (the base
@@ -159,9 +125,14 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
         p, E, R, eta, al, u0, tf = [np.ascontiguousarray(a, dtype=np.float64) for a in
                                     (p_eval[sel], b["E_star"][sel], b["R"][sel], b["eta"][sel],
                                      alpha[sel], us_in, t_fp[sel])]
-        _tire_kernel(tables.kernel_data(theory), _scalars(tables, theory, None),
-                     Cases(p, E, R, eta, u0), al, tf, h, BarusTargets(vr, dv),
-                     Quad(x, w, QUAD_WIDTH), TireOut(T, ue, ui, us, ut, fl, st))
+        args = (Cases(p, E, R, eta, u0), al, tf, h, BarusTargets(vr, dv, np.empty(0)),
+                Quad(x, w, QUAD_WIDTH), TireOut(T, ue, ui, us, ut, fl, st))
+        tab, sc = tables.kernel_data(theory), _scalars(tables, theory, None)
+        if method == "fast":
+            from ._barus_fast import tire_kernel
+            tire_kernel(tab, sc, *fast_setup(tables, theory, None), *args, fast_scratch())
+        else:
+            _tire_kernel(tab, sc, *args)
     with np.errstate(invalid="ignore"):
         piezo = {"u_inf": ui, "u_start": us, "t_du": T[1 + r.size], "t_star": T[0],
                  "trapped": st == _TRAPPED, "u_trap": ut, "fluid_load_fraction": fl,

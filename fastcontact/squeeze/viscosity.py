@@ -52,12 +52,15 @@ DEFAULT_P_START = 1e-3
 ST_OK, ST_TRAPPED, ST_OUT, ST_PIEZO, ST_BELOW = 0, 1, 2, 3, 4
 #: readable ``status`` of each code (ST_*)
 STATUS = ("ok", "trapped", "out_of_table", "piezo_limit", "start_below_equilibrium")
-#: targets shared by all cases: ratios ū/ū∞ (t_star's 1.01 first, then the ratio targets) [-]
-#: and dvs = Δu/h_rms of the Δu targets [-]
-BarusTargets = namedtuple("BarusTargets", "ratios dvs")
+#: the exit search stops this far below ln(ū(0) − ū∞) (ū is then ū∞ to round-off)
+W_SPAN = 60.0
+#: targets shared by all cases: ratios ū/ū∞ (t_star's 1.01 first, then the ratio targets) [-],
+#: dvs = Δu/h_rms of the Δu targets [-] and times [s] of the ū(t) outputs
+BarusTargets = namedtuple("BarusTargets", "ratios dvs times")
 #: outputs of :func:`squeeze_out_piezo`, one column per case: T (nt, n) target times [s],
-#: u_inf, u_start [m], tau0 [s], g_start (rate factor at the start) [-], status (int8)
-BarusOut = namedtuple("BarusOut", "T u_inf u_start tau0 g_start status")
+#: U (n_times, n) ū at the times [m], u_inf, u_start [m], tau0 [s], g_start (rate factor at
+#: the start) [-], status (int8)
+BarusOut = namedtuple("BarusOut", "T U u_inf u_start tau0 g_start status")
 
 
 # =========================================================================== closed forms
@@ -120,13 +123,20 @@ def _rate_factor(a):
     k0 = int(u) - 2
     if k0 < 0:
         k0 = 0
-    q = 0.0
-    for j in range(6):
-        w = 1.0
-        for i in range(6):
-            if i != j:
-                w *= (u - (k0 + i)) / (j - i)
-        q += w * _G_Q[k0 + j]
+    # Lagrange weights w_j = Π_{i≠j} (u - k0 - i) / Π_{i≠j} (j - i): prefix and suffix
+    # products of the six factors, and the constant denominators' inverses
+    d0 = u - k0
+    f0, f1, f2, f3, f4, f5 = d0, d0 - 1.0, d0 - 2.0, d0 - 3.0, d0 - 4.0, d0 - 5.0
+    p01 = f0 * f1
+    p012 = p01 * f2
+    s45 = f4 * f5
+    s345 = f3 * s45
+    q = (-1.0 / 120.0) * (f1 * f2 * s345) * _G_Q[k0]
+    q += (1.0 / 24.0) * (f0 * f2 * s345) * _G_Q[k0 + 1]
+    q += (-1.0 / 12.0) * (p01 * s345) * _G_Q[k0 + 2]
+    q += (1.0 / 12.0) * (p012 * s45) * _G_Q[k0 + 3]
+    q += (-1.0 / 24.0) * (p012 * f3 * f5) * _G_Q[k0 + 4]
+    q += (1.0 / 120.0) * (p012 * f3 * f4) * _G_Q[k0 + 5]
     return -math.expm1(-s * q) / (2.0 * a)
 
 
@@ -241,6 +251,38 @@ def _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i):
         T[k, i] = tau * t_cur
 
 
+@njit(cache=True)
+def exit_w(tab, sc, x0, api, vinf, w0, target, quad):
+    """w = ln(v − v∞) reached after reduced time ``target`` from w0 (-inf: beyond W_SPAN)."""
+    width = quad.width
+    t = 0.0
+    w = w0
+    while w > w0 - W_SPAN:
+        wn = w - width
+        dt = _segment(tab, sc, x0, api, vinf, wn, w, quad)
+        if t + dt >= target:
+            lo = wn
+            hi = w
+            y = 0.5 * (lo + hi)
+            for _ in range(100):
+                f = t + _segment(tab, sc, x0, api, vinf, y, w, quad) - target
+                if f > 0.0:
+                    lo = y
+                else:
+                    hi = y
+                dtdw = _integrand(tab, sc, x0, api, vinf, y)
+                yn = y + f / dtdw if dtdw < math.inf else 0.5 * (lo + hi)
+                if not (lo < yn < hi):
+                    yn = 0.5 * (lo + hi)
+                if abs(yn - y) <= 1e-14 * max(1.0, abs(y)) or hi - lo <= 1e-14 * max(1.0, abs(y)):
+                    return yn
+                y = yn
+            return y
+        t += dt
+        w = wn
+    return -math.inf
+
+
 @njit(cache=True, inline="always")
 def _case_head(cs, sc, h, i):
     """(x0 = ln(p0/E*), τ0 = 3ηR²/(2 h_rms² p0) [s], x0 within the tables) of case i."""
@@ -251,10 +293,12 @@ def _case_head(cs, sc, h, i):
 
 @njit(cache=True)
 def _no_times(out, i, status):
-    """Row i of ``out`` (:data:`BarusOut`) gets ``status`` and NaN target times."""
+    """Row i of ``out`` (:data:`BarusOut`) gets ``status``, NaN target times and NaN ū(t)."""
     out.status[i] = status
     for k in range(out.T.shape[0]):
         out.T[k, i] = math.nan
+    for k in range(out.U.shape[0]):
+        out.U[k, i] = math.nan
 
 
 @njit(cache=True)
@@ -285,6 +329,13 @@ def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
         return
     out.status[i] = ST_TRAPPED if x0 >= sc[0].x_trap else ST_OK
     _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, out.T, i)
+    w0 = math.log(vs - vinf)
+    for k in range(tg.times.size):
+        tt = tg.times[k] / tau
+        if tt == 0.0:
+            out.U[k, i] = vs * h
+        else:
+            out.U[k, i] = (vinf + math.exp(exit_w(tab, sc, x0, api, vinf, w0, tt, quad))) * h
 
 
 @njit(parallel=True, cache=True)
@@ -343,8 +394,8 @@ def _scalars(tables, theory, sigma_trap):
 
 
 def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_THEORY,
-                      u_start=None, ratios=(1.1, 1.01, 1.001), du=(), quad_order=10,
-                      quad_width=1.0, sigma_trap=None):
+                      u_start=None, ratios=(1.1, 1.01, 1.001), du=(), times=(),
+                      method="fast", quad_order=10, quad_width=1.0, sigma_trap=None):
     """Squeeze-out times of a flat block with a Barus fluid η = η0 exp(α_pv p_f) [s].
 
     Parameters
@@ -362,8 +413,17 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
         Initial separation [m]; None: where p_cont = 1e-3 p0 (as :func:`squeeze_out`).
     ratios, du : sequence
         Targets ū/ū∞ > 1 (columns ``t_ratio_<r>``) and ū - ū∞ [m] (``t_du_<Δu>``).
+    times : sequence of float, default ()
+        Times [s] >= 0 (inf allowed) → columns ``u_at_<t>``: ū at that time [m] (ū(0) =
+        u_start; ū∞, or ū_trap on a trapped row, as t → ∞).
+    method : {"fast", "quad"}, default "fast"
+        "fast": every time is two interpolations of the constant-viscosity time primitive
+        plus the tabulated Barus correction (:mod:`._barus_primitive`, built once per
+        tables and theory in ~5-20 ms); rows it does not serve (α p0 > 0.6, p0 within 1 % of
+        the trap pressure or beyond, outside the tables) take the per-case quadrature in the
+        same pass. "quad": the per-case quadrature for every row.
     quad_order, quad_width :
-        Gauss–Legendre order and panel width in w = ln(ū - ū∞) [-].
+        Gauss–Legendre order and panel width in w = ln(ū - ū∞) [-] of the quadrature.
     sigma_trap : float, optional
         Reduced conductivity below which σ is treated as 0 (default the tables' floor).
 
@@ -395,6 +455,10 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     us = np.array(np.nan) if u_start is None else check_positive("u_start", u_start, "[m]",
                                                                     allow_inf=False)
     ratios, du, qo, width = _check_targets(ratios, du, quad_order, quad_width)
+    method = _check_method_name(method)
+    times = np.ascontiguousarray(np.atleast_1d(np.asarray(
+        check_positive("times", times, "[s]", allow_zero=True, allow_inf=True)
+        if np.size(times) else np.empty(0), dtype=np.float64)).ravel())
     shape = np.broadcast(p0, E_star, R, eta, alpha_pv, us).shape
     flat = [np.ascontiguousarray(np.broadcast_to(a, shape).ravel(), dtype=np.float64)
             for a in (p0, E_star, R, eta, alpha_pv, us)]
@@ -404,13 +468,56 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     vr = np.ascontiguousarray(np.concatenate(([1.01], ratios)))
     dv = np.ascontiguousarray(du / h)
     T = np.empty((vr.size + dv.size, n))
+    U = np.empty((times.size, n))
     uinf, ustart, tau0, gs = (np.empty(n) for _ in range(4))
     status = np.empty(n, dtype=np.int8)
     x, w = gauss_legendre(qo)
     cs = Cases(flat[0], flat[1], flat[2], flat[3], flat[5])
-    _piezo_kernel(tables.kernel_data(theory), sc, cs, flat[4], h, BarusTargets(vr, dv),
-                  Quad(x, w, width), BarusOut(T, uinf, ustart, tau0, gs, status))
-    return _piezo_frame(flat, ratios, du, T, uinf, ustart, tau0, gs, status, theory)
+    args = (cs, flat[4], h, BarusTargets(vr, dv, times), Quad(x, w, width),
+            BarusOut(T, U, uinf, ustart, tau0, gs, status))
+    if method == "fast":
+        from ._barus_fast import squeeze_kernel
+        squeeze_kernel(tables.kernel_data(theory), sc, *fast_setup(tables, theory, sigma_trap),
+                       *args, fast_scratch())
+    else:
+        _piezo_kernel(tables.kernel_data(theory), sc, *args)
+    df = _piezo_frame(flat, ratios, du, times, T, U, uinf, ustart, tau0, gs, status, theory,
+                      method)
+    if method == "fast":
+        df.attrs["barus_correction"] = fast_info(tables, theory, sigma_trap)
+    return df
+
+
+def fast_setup(tables, theory, sigma_trap):
+    """(primitive, Barus table, series coefficients, largest ln(p0/E*) served) of the fast
+    path for (tables, theory)."""
+    from ._barus_primitive import h_coefficients
+    from .primitive import fast_limit
+    model = squeeze_model(tables, theory, sigma_trap)
+    pr = model.primitive()
+    bt, _info = model.barus_table()
+    return pr, bt, h_coefficients(), float(fast_limit(model))
+
+
+def fast_info(tables, theory, sigma_trap):
+    """Provenance of the fast path's Barus correction: its nodes, series limits and the
+    measured interpolation error of S (:func:`._barus_primitive.build`)."""
+    info = squeeze_model(tables, theory, sigma_trap).barus_table()[1]
+    return {k: info[k] for k in ("nodes", "k_max", "api_fast", "max_rel_err_S",
+                                 "checked_cells")}
+
+
+def fast_scratch():
+    """Per-thread scratch rows of the fast kernels' series coefficients."""
+    from numba import config
+    from ._barus_primitive import K_MAX
+    return np.empty((config.NUMBA_NUM_THREADS, K_MAX + 1))
+
+
+def _check_method_name(method):
+    if method not in ("fast", "quad"):
+        raise ValueError(f"method = {method!r} is invalid: must be 'fast' or 'quad'")
+    return method
 
 
 def _check_targets(ratios, du, quad_order, quad_width):
@@ -429,7 +536,8 @@ def _check_targets(ratios, du, quad_order, quad_width):
     return ratios, du, qo, width
 
 
-def _piezo_frame(flat, ratios, du, T, uinf, ustart, tau0, gs, status, theory):
+def _piezo_frame(flat, ratios, du, times, T, U, uinf, ustart, tau0, gs, status, theory,
+                 method):
     """The result DataFrame of :func:`squeeze_out_piezo` from the kernel outputs."""
     cols = {"p0": flat[0], "E_star": flat[1], "R": flat[2], "eta": flat[3],
             "alpha_pv": flat[4], "u_start": ustart, "u_inf": uinf, "t_star": T[0]}
@@ -437,6 +545,8 @@ def _piezo_frame(flat, ratios, du, T, uinf, ustart, tau0, gs, status, theory):
         cols[column_name("t_ratio", r)] = T[1 + k]
     for k, d in enumerate(du):
         cols[column_name("t_du", d)] = T[1 + ratios.size + k]
+    for k, t in enumerate(times):
+        cols[column_name("u_at", t)] = U[k]
     cols.update({"tau0": tau0, "barus_number": flat[4] * flat[0], "rate_factor_start": gs,
                  "piezo_limit": status == ST_PIEZO, "trapped": status == ST_TRAPPED,
                  "out_of_table": status == ST_OUT,
@@ -446,7 +556,8 @@ def _piezo_frame(flat, ratios, du, T, uinf, ustart, tau0, gs, status, theory):
              "u_start": "m", "u_inf": "m", "tau0": "s", "barus_number": "1",
              "rate_factor_start": "1"}
     units.update({c: "s" for c in cols if c.startswith("t_")})
-    df.attrs.update({"units": units, "theory": theory, "viscosity": "Barus",
+    units.update({c: "m" for c in cols if c.startswith("u_at_")})
+    df.attrs.update({"units": units, "theory": theory, "viscosity": "Barus", "method": method,
                      "model": "dū/dt = -(8σ0/R²)(p0-p_cont) g(α(p0-p_cont)), "
                               "g = Φ⁻¹(a)/(2a), Φ(b) = 1 + (1-b)ln(1-b)/b",
                      "references": ["doi:10.2475/ajs.s3-45.266.87",
@@ -457,18 +568,17 @@ def _piezo_frame(flat, ratios, du, T, uinf, ustart, tau0, gs, status, theory):
 # =========================================================================== hook
 def _squeeze_hook(tables, kw, alpha_pv):
     """``squeeze_out(..., alpha_pv=α)``: α = 0 everywhere → the base engine (unchanged
-    output); otherwise :func:`squeeze_out_piezo` (no ``times``/``u_at`` columns)."""
+    output); otherwise :func:`squeeze_out_piezo` (target times and ``u_at`` columns)."""
     a = check_positive("alpha_pv", alpha_pv, "[1/Pa]", allow_zero=True)
     rest = {k: v for k, v in kw.items() if k != "alpha_pv"}
     if not np.any(a):
         return squeeze_out(tables, **rest)
-    if np.size(rest.get("times", ())):
-        raise ValueError("times = ... is invalid with alpha_pv > 0: the Barus engine returns "
-                         "target times only (use ratios / du)")
     return squeeze_out_piezo(tables, p0=rest["p0"], E_star=rest["E_star"], R=rest["R"],
                              eta=rest["eta"], alpha_pv=a, theory=rest.get("theory", "average"),
                              u_start=rest.get("u_start"), ratios=rest.get("ratios", (1.1, 1.01, 1.001)),
-                             du=rest.get("du", ()), quad_order=rest.get("quad_order", 10),
+                             du=rest.get("du", ()), times=rest.get("times", ()),
+                             method=rest.get("method", "fast"),
+                             quad_order=rest.get("quad_order", 10),
                              quad_width=rest.get("quad_width", 1.0),
                              sigma_trap=rest.get("sigma_trap"))
 

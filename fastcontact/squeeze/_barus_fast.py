@@ -1,0 +1,172 @@
+"""Barus squeeze-out and tire footprint on the time primitive (``method="fast"``).
+
+Every case is a few interpolations: the base primitive T at the start and at each target,
+and the Barus correction S of :mod:`._barus_primitive` at the same separations,
+t = τ0 {T(ū) - T(ū_start) + α p0 [S(ū) - S(ū_start)]}; ū at the footprint exit by Newton on
+the same two (:func:`~._barus_primitive.u_at_time`). Rows the tables do not serve this way
+(outside the tables, p0 within 1 % of the trap pressure or beyond, α p0 > API_FAST) run the
+per-case quadrature of :mod:`.viscosity` / :mod:`.tire_piezo` in the same pass.
+"""
+from __future__ import annotations
+
+import math
+
+from numba import get_thread_id, njit, prange
+
+from ..kernels.borrow import borrowed
+
+from ._barus_primitive import BarusTable, s_value, series_order, shift, u_at_time
+from ._kernels import Cases, Quad
+from ._primitive_eval import Primitive, inverse_constants, row_value, stencil, t_of_z
+from .tire_piezo import _BELOW as TIRE_BELOW
+from .tire_piezo import _OK as TIRE_OK
+from .tire_piezo import TireOut, _tire_case
+from .viscosity import (ST_BELOW, ST_OK, BarusOut, BarusTargets, _case_head, _no_times,
+                        _piezo_case, _rate_factor)
+
+__all__ = ["squeeze_kernel", "tire_kernel"]
+#: the records' types, by name in this module: numba's parfor lowering rebuilds the kernels'
+#: argument types from the module globals
+_RECORDS = (BarusTable, BarusOut, BarusTargets, Cases, Primitive, Quad, TireOut)
+
+
+@njit(cache=True, inline="always")
+def _served(pr, sc, c, cs, alpha, h, x_fast, i):
+    """(x0, τ0 [s], A = α p0, K, stencil) of case i; K < 0: not served by the primitive."""
+    x0, tau, inside = _case_head(cs, sc, h, i)
+    A = alpha[i] * cs.p0[i]
+    K = series_order(c, A)
+    if not inside or x0 > x_fast:
+        K = -1
+    st = stencil(pr, x0) if K >= 0 else (-1, 0.0, 0.0, 0.0, 0.0)
+    if st[0] < 0:
+        K = -1
+    return x0, tau, A, K, st
+
+
+@njit(cache=True, inline="always")
+def _start(pr, bt, st, E, K, x0, vs_in):
+    """(v∞, v_start, z_start, T(start), S(start), 1 - π_c/π0 at the start) of a served case;
+    v_start <= v∞ is returned as is (the caller flags it)."""
+    vinf = math.exp(row_value(pr.lnv, st))
+    if vs_in != vs_in:
+        zs = row_value(pr.zs, st)
+        vs = vinf * (1.0 + math.exp(zs))
+    else:
+        vs = vs_in
+        if not (vs > vinf):
+            return vinf, vs, math.nan, math.nan, math.nan, math.nan
+        if vs == math.inf:
+            return vinf, vs, math.inf, 0.0, 0.0, 1.0
+        zs = math.log(vs / vinf - 1.0)
+    Ss, lnps = s_value(bt, E, K, x0, vs)
+    return vinf, vs, zs, t_of_z(pr, st, vinf, zs), Ss, -math.expm1(lnps - x0)
+
+
+@njit(cache=True, inline="always")
+def _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, T, i):
+    """Times [s] from the start to each target (ratios × v∞, then v∞ + dv) into column i."""
+    nr = tg.ratios.size
+    for k in range(T.shape[0]):
+        r1 = tg.ratios[k] - 1.0 if k < nr else tg.dvs[k - nr] / vinf
+        vt = vinf * (1.0 + r1)
+        if vt >= vs:
+            T[k, i] = 0.0
+            continue
+        S, _ = s_value(bt, E, K, x0, vt)
+        T[k, i] = tau * (t_of_z(pr, st, vinf, math.log(r1)) - Ts + A * (S - Ss))
+
+
+@njit(cache=True)
+def _squeeze_case(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, i, out, E):
+    """Case i into row/column i of ``out`` (:data:`~.viscosity.BarusOut`); E: scratch of
+    K_MAX + 1 series coefficients."""
+    x0, tau, A, K, st = _served(pr, sc, c, cs, alpha, h, x_fast, i)
+    if K < 0:
+        _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out)
+        return
+    shift(c, A, K, E)
+    out.tau0[i] = tau
+    vinf, vs, zs, Ts, Ss, ds = _start(pr, bt, st, E, K, x0, cs.us[i] / h)
+    out.u_inf[i] = vinf * h
+    out.u_start[i] = vs * h
+    if not (vs * h > vinf * h):  # a given start at or below ū∞ (as reported, SI)
+        _no_times(out, i, ST_BELOW)
+        out.g_start[i] = math.nan
+        return
+    out.g_start[i] = _rate_factor(A * ds) if A > 0.0 else 1.0
+    out.status[i] = ST_OK
+    _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, out.T, i)
+    if tg.times.size:
+        ic = inverse_constants(pr, st)
+        for k in range(tg.times.size):
+            out.U[k, i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss,
+                                    tg.times[k] / tau, ic) * h
+
+
+@njit(parallel=True, cache=True)
+def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, out, scratch):
+    for i in prange(cs.p0.size):
+        _squeeze_case(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, i, out,
+                      scratch[get_thread_id()])
+
+
+@njit(cache=True)
+def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, out, scratch):
+    """Barus squeeze-out of every case (``cs`` :class:`~._kernels.Cases`, α [1/Pa] apart)
+    into ``out`` (:data:`~.viscosity.BarusOut`): the primitive where it serves the case, else
+    the per-case quadrature (``quad``). ``scratch`` (threads, K_MAX + 1): one row of series
+    coefficients per thread.
+
+    The records reach the per-case helper as borrowed views (:mod:`fastcontact.kernels.borrow`;
+    passed by value each call costs two contended atomic reference counts per array, most of
+    a case's time). They are borrowed here and handed to the parallel loop as arguments:
+    numba's parfor lowering rebuilds a namedtuple captured by a prange body from the
+    definition of its variable, which must be an argument or the class itself."""
+    _squeeze_par(borrowed(tab), borrowed(sc), borrowed(pr), borrowed(bt), borrowed(c), x_fast,
+                 borrowed(cs), borrowed(alpha), h, borrowed(tg), borrowed(quad), borrowed(out),
+                 borrowed(scratch))
+
+
+@njit(cache=True)
+def _tire_fast_case(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, i, out, E):
+    """Case i into row/column i of ``out`` (:data:`~.tire_piezo.TireOut`); E: scratch."""
+    x0, tau, A, K, st = _served(pr, sc, c, cs, alpha, h, x_fast, i)
+    if K < 0:
+        _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out)
+        return
+    shift(c, A, K, E)
+    vinf, vs, zs, Ts, Ss, ds = _start(pr, bt, st, E, K, x0, cs.us[i] / h)
+    out.u_inf[i] = vinf * h
+    out.u_start[i] = vs * h
+    out.u_trap[i] = math.nan
+    if not (vs * h > vinf * h):
+        for k in range(out.T.shape[0]):
+            out.T[k, i] = math.nan
+        out.u_exit[i] = math.nan
+        out.flf[i] = math.nan
+        out.status[i] = TIRE_BELOW
+        return
+    out.flf[i] = 0.0
+    out.status[i] = TIRE_OK
+    _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, out.T, i)
+    ic = inverse_constants(pr, st)
+    out.u_exit[i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, t_fp[i] / tau,
+                              ic) * h
+
+
+@njit(parallel=True, cache=True)
+def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, out, scratch):
+    for i in prange(cs.p0.size):
+        _tire_fast_case(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, i, out,
+                        scratch[get_thread_id()])
+
+
+@njit(cache=True)
+def tire_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, out, scratch):
+    """Barus tire footprint of every case (footprint time t_fp [s] apart) into ``out``
+    (:data:`~.tire_piezo.TireOut`): targets and ū at t_fp from the primitive where it serves
+    the case, else the per-case quadrature (records borrowed as in :func:`squeeze_kernel`)."""
+    _tire_par(borrowed(tab), borrowed(sc), borrowed(pr), borrowed(bt), borrowed(c), x_fast,
+              borrowed(cs), borrowed(alpha), borrowed(t_fp), h, borrowed(tg), borrowed(quad),
+              borrowed(out), borrowed(scratch))

@@ -1,0 +1,363 @@
+"""The Barus squeeze-out at table speed: the base time primitive plus a series of 1-D ones.
+
+With a Barus fluid the squeeze rate is the constant-viscosity rate times g(a),
+a = α p0 d, d = 1 - π_c(v)/π0 (:mod:`.viscosity`), so the reduced time from v_s down to v is
+
+    t̃ = ∫_v^{v_s} dv'/(σ̄ d g(a)) = [T(x0, v) - T(x0, v_s)] + α p0 [S(v) - S(v_s)],
+
+T the constant-viscosity time primitive (:mod:`.primitive`) and, with 1/g(a) = 1 + a h(a),
+
+    S(v) = ∫_v^∞ h(α p0 d(v'))/σ̄(v') dv'
+
+— the correction has no 1/d: it is regular at ū∞. h is analytic for |a| < 1 with positive
+Taylor coefficients c_k (h(0) = 2/3, c_k ≈ 0.06 k^-2.2), so for A = α p0 <= ``API_FAST``
+the truncation P_K(a) = Σ_{k<=K} c_k a^k is exact to ``SERIES_TOL`` on a ∈ [0, A] and, with
+y = π_c(v)/π0 = 1 - d,
+
+    P_K(A (1 - y)) = Σ_j E_j (-y)^j,   E_j = Σ_{k>=j} C(k, j) c_k A^k   (a Taylor shift),
+    S(v) = Σ_j E_j (-1)^j y(v)^j R_j(v),   R_j(v) = π_c(v)^-j ∫_v^∞ π_c(v')^j/σ̄(v') dv'.
+
+The R_j depend on v alone (neither on p0 nor on α): they are tabulated once per (tables,
+theory) on the primitive's fine grid in s = ln v as ρ_j = σ̄ R_j (smooth, O(1)) with their
+exact s-derivatives dρ_j/ds = ρ_j (d ln σ̄/ds - j d ln π_c/ds) - v (cubic Hermite), beside
+ln π_c and ln σ̄. A case then costs its E_j (O(K²), K ≈ 10 at α p0 = 0.1) and K + 1
+multiply-adds per evaluated separation. Above v_ext (π_c/π0 < e^-40) only j = 0 remains,
+the closed-form flat-film tail of the base primitive. Since every E_j is a sum of positive
+terms and Σ_j E_j <= P_K(2A), rounding is not amplified for A <= 1/2 and by at most
+P_K(1.2) ≈ 2 at A = 0.6; beyond ``API_FAST`` the per-case quadrature of :mod:`.viscosity`
+runs.
+
+ū at a given time solves F(τ) = τ + α p0 S(v(τ)) = F*, τ the base primitive's time and v(τ)
+its exact inverse: Newton with F' = 1/g(a) converges from the base solution (F concave:
+the first step lands below the root, the next ones rise to it monotonically).
+
+References: C. Barus, Am. J. Sci. 45, 87 (1893), doi:10.2475/ajs.s3-45.266.87;
+B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037.
+"""
+from __future__ import annotations
+
+import math
+import time as _clock
+from collections import namedtuple
+from decimal import Decimal, localcontext
+from functools import lru_cache
+
+import numpy as np
+from numba import njit, prange
+
+from ..kernels.quadrature import gauss_legendre
+from . import _kernels as qk
+from ._primitive_build import _pstate, fast_limit, profile
+from ..kernels.hermite import cubic_basis
+from ._primitive_eval import _index_map, _locate, z_of_t_at
+
+__all__ = ["API_FAST", "K_MAX", "SERIES_TOL", "BarusTable", "build", "h_coefficients", "h_series",
+           "series_order", "shift", "s_value", "u_at_time"]
+
+#: highest series order of h; A = α p0 above API_FAST runs the per-case quadrature
+K_MAX = 48
+API_FAST = 0.6
+#: bound on Σ_{k>K} c_k A^(k+1) of the truncated series (relative error of t̃ it may cause)
+SERIES_TOL = 1e-13
+#: Gauss–Legendre order of the cell integrals; sub-panels keep K_MAX |Δ ln π_c| <= SUB_SPAN
+CELL_ORDER = 8
+SUB_SPAN = 1.0
+
+#: the tabulated R_j of one (tables, theory): nodes xn in s = ln v (the last one at ln v_ext)
+#: and their locator (blo, bdz, bidx: fractional node index at uniform s samples, as the
+#: primitive's rows, so that its ``_locate`` serves both); ST (ns, 4) = ln π_c, d ln π_c/ds, ln σ̄, d ln σ̄/ds; RHO, DRHO
+#: (ns, K_MAX + 1) = ρ_j = σ̄ R_j and dρ_j/ds; v_ext, c, d: the base primitive's closed-form
+#: tail above v_ext (T there is ∫dy/(y³ - c y), y = v + d)
+BarusTable = namedtuple("BarusTable", "xn blo bdz bidx ST RHO DRHO v_ext c d")
+
+
+def _inverse_series(p, n):
+    """Coefficients of 1/p (p[0] != 0), n terms (Decimal arithmetic)."""
+    q = [Decimal(0)] * n
+    q[0] = 1 / p[0]
+    for k in range(1, n):
+        q[k] = -sum(p[i] * q[k - i] for i in range(1, min(k, len(p) - 1) + 1)) / p[0]
+    return q
+
+
+def h_series(n=K_MAX + 2, digits=60):
+    """Taylor coefficients c_0..c_{n-1} of h(a) = (1/g(a) - 1)/a [-] (~20 ms).
+
+    g(a) = b(a)/(2a) with b = Φ⁻¹(a), Φ(b) = 1 + (1 - b) ln(1 - b)/b = b φ(b),
+    φ(b) = Σ_{m>=1} b^(m-1)/(m(m+1)). Lagrange inversion, [a^k] b = [b^(k-1)] ψ^k / k with
+    ψ = 1/φ, then 1/g by series division; in ``digits``-digit decimal arithmetic (the
+    powers ψ^k have coefficients up to ~2^k that cancel: float64 loses every digit of c_k
+    beyond k ≈ 30)."""
+    with localcontext() as ctx:
+        ctx.prec = digits
+        m = n + 2
+        phi = [Decimal(1) / ((k + 1) * (k + 2)) for k in range(m)]
+        psi = _inverse_series(phi, m)
+        b = [Decimal(0)] * (m + 1)
+        pw = [Decimal(1)] + [Decimal(0)] * (m - 1)  # ψ^0
+        for k in range(1, m + 1):
+            pw = [sum(pw[i] * psi[j - i] for i in range(j + 1)) for j in range(m)]  # ψ^k
+            b[k] = pw[k - 1] / k
+        g = [b[k + 1] / 2 for k in range(m)]  # g = b/(2a)
+        ig = _inverse_series(g, m)
+        return np.array([float(x) for x in ig[1:n + 1]])
+
+
+@lru_cache(maxsize=1)
+def h_coefficients():
+    """c_0..c_{K_MAX+1} of h (the last one bounds the truncation), computed on first use."""
+    return np.ascontiguousarray(h_series(K_MAX + 2))
+
+
+@njit(cache=True)
+def series_order(c, A):
+    """Smallest K <= K_MAX with A c_{K+1} A^{K+1}/(1 - A) <= SERIES_TOL (c decreasing);
+    -1 for A > API_FAST (the per-case quadrature's)."""
+    if A == 0.0:
+        return 0
+    if not (A <= API_FAST):
+        return -1
+    pw = A * A  # A^(K+1) · A at K = 0
+    for k in range(K_MAX + 1):
+        if c[k + 1] * pw / (1.0 - A) <= SERIES_TOL:
+            return k
+        pw *= A
+    return -1
+
+
+@njit(cache=True)
+def shift(c, A, K, E):
+    """E_j = Σ_{k=j}^K C(k, j) c_k A^k, j = 0..K, into E (Taylor shift by one of the
+    coefficients c_k A^k; positive terms only)."""
+    p = 1.0
+    for k in range(K + 1):
+        E[k] = c[k] * p
+        p *= A
+    for i in range(K):
+        for k in range(K - 1, i - 1, -1):
+            E[k] += E[k + 1]
+
+
+@njit(cache=True, inline="always")
+def s_value(bt, E, K, x0, v):
+    """(S(v), ln π_c(v)): S = Σ_{j<=K} E_j (-y)^j R_j(v), y = π_c(v)/π0, π0 = e^x0."""
+    if v >= bt.v_ext:
+        return E[0] * qk._tail_int(bt.c, v + bt.d, math.inf), math.nan
+    s = math.log(v)
+    sn = bt.xn
+    i = _locate(bt, s)
+    if i < 0:  # v below the lowest ū∞ served or at v_ext to rounding: the end cell
+        i = 0 if s < sn[0] else sn.size - 2
+    h = sn[i + 1] - sn[i]
+    h00, h10, h01, h11 = cubic_basis((s - sn[i]) / h, h)
+    ST = bt.ST
+    lnp = h00 * ST[i, 0] + h10 * ST[i, 1] + h01 * ST[i + 1, 0] + h11 * ST[i + 1, 1]
+    lns = h00 * ST[i, 2] + h10 * ST[i, 3] + h01 * ST[i + 1, 2] + h11 * ST[i + 1, 3]
+    my = -math.exp(lnp - x0)
+    RHO = bt.RHO
+    DRHO = bt.DRHO
+    acc = 0.0
+    yp = 1.0
+    for j in range(K + 1):
+        rho = h00 * RHO[i, j] + h10 * DRHO[i, j] + h01 * RHO[i + 1, j] + h11 * DRHO[i + 1, j]
+        acc += E[j] * yp * rho
+        yp *= my
+    return acc * math.exp(-lns), lnp
+
+
+@njit(cache=True, inline="always")
+def _inv_g(c, K, a):
+    """1/g(a) = 1 + a P_K(a) (the truncated series, consistent with S)."""
+    p = 0.0
+    for k in range(K, -1, -1):
+        p = p * a + c[k]
+    return 1.0 + a * p
+
+
+@njit(cache=True)
+def u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic):
+    """v = ū/h_rms reached at reduced time tt after the start (T(start) = Ts, S(start) = Ss):
+    Newton on F(τ) = τ + A S(v(τ)) = Ts + A Ss + tt, v(τ) the base primitive's inverse."""
+    if tt == 0.0:
+        return vs
+    if tt == math.inf:
+        return vinf
+    target = Ts + A * Ss + tt
+    tau = Ts + tt
+    v = vs
+    for _ in range(40):
+        z = z_of_t_at(pr, st, vinf, tau, ic)
+        v = vinf * (1.0 + math.exp(z))
+        s, lnp = s_value(bt, E, K, x0, v)
+        f = tau + A * s - target
+        step = f / _inv_g(c, K, A * -math.expm1(lnp - x0))
+        tau -= step
+        if abs(step) <= 1e-15 * tau:
+            break
+    z = z_of_t_at(pr, st, vinf, tau, ic)
+    return min(vinf * (1.0 + math.exp(z)), vs)
+
+
+# =========================================================================== build
+@njit(parallel=True, cache=True)
+def _nodes_kernel(pf, mp, sn, ST):
+    """(ln π_c, d ln π_c/ds, ln σ̄, d ln σ̄/ds) at the nodes sn (the primitive's profile below
+    the table top, the analytic tail above)."""
+    for i in prange(sn.size):
+        lp, ls, dlp, dls = _pstate(pf, mp, math.exp(sn[i]))
+        ST[i, 0] = lp
+        ST[i, 1] = dlp
+        ST[i, 2] = ls
+        ST[i, 3] = dls
+
+
+@njit(parallel=True, cache=True)
+def _cells_kernel(pf, mp, sn, ST, glx, glw, I):
+    """I[i, j] = ∫_{v_i}^{v_i+1} (π_c(v')/π_c(v_i))^j /σ̄(v') dv' (composite GL in s, with
+    sub-panels so that the steepest power varies by at most e^SUB_SPAN on one)."""
+    nj = I.shape[1]
+    for i in prange(sn.size - 1):
+        lp0 = ST[i, 0]
+        m = max(1, int(math.ceil((nj - 1) * abs(ST[i + 1, 0] - lp0) / SUB_SPAN)))
+        hw = (sn[i + 1] - sn[i]) / m
+        for j in range(nj):
+            I[i, j] = 0.0
+        for p in range(m):
+            mid = sn[i] + (p + 0.5) * hw
+            for q in range(glx.size):
+                s = mid + 0.5 * hw * glx[q]
+                lp, ls, dlp, dls = _pstate(pf, mp, math.exp(s))
+                base = 0.5 * hw * glw[q] * math.exp(s - ls)
+                r = math.exp(lp - lp0)
+                for j in range(nj):
+                    I[i, j] += base
+                    base *= r
+
+
+@njit(cache=True)
+def _sweep(ST, sn, I, u0, R_top0, RHO, DRHO):
+    """R_j from the top down, R_j(i) = (π_{i+1}/π_i)^j R_j(i+1) + I[i, j]; then ρ_j = σ̄ R_j
+    and dρ_j/ds into RHO, DRHO. At the top (v >= v_ext) R_0 is the closed-form tail and
+    R_j, j >= 1, Laplace's leading term u0/(j σ̄): weighted by (π_top/π)^j < e^(-40 j) at
+    every v where y = π_c/π0 is not itself below e^-40."""
+    ns, nj = RHO.shape
+    R = np.empty(nj)
+    R[0] = R_top0
+    for j in range(1, nj):
+        R[j] = u0 / (j * math.exp(ST[ns - 1, 2]))
+    for i in range(ns - 1, -1, -1):
+        if i < ns - 1:
+            q = math.exp(ST[i + 1, 0] - ST[i, 0])
+            qp = 1.0
+            for j in range(nj):
+                R[j] = qp * R[j] + I[i, j]
+                qp *= q
+        sig = math.exp(ST[i, 2])
+        v = math.exp(sn[i])
+        for j in range(nj):
+            RHO[i, j] = sig * R[j]
+            DRHO[i, j] = RHO[i, j] * (ST[i, 3] - j * ST[i, 1]) - v
+
+
+@njit(parallel=True, cache=True)
+def _sample_kernel(pf, mp, s, out):
+    for i in prange(s.size):
+        lp, ls, dlp, dls = _pstate(pf, mp, math.exp(s[i]))
+        out[i, 0] = lp
+        out[i, 1] = ls
+
+
+#: node spacing: at most DS_MAX in s = ln v, DLNS_MAX in ln σ̄ and DLNP_MAX in ln π_c
+#: (the nodes are uniform in χ = s/DS_MAX + ln σ̄/DLNS_MAX - ln π_c/DLNP_MAX: dense where σ̄
+#: collapses towards percolation, as the primitive's rows)
+DS_MAX = 0.02
+DLNS_MAX = 0.05
+DLNP_MAX = 0.2
+
+
+def _nodes(pf, mp, s_lo, s_hi):
+    """Nodes sn on [s_lo, s_hi], uniform in χ (see DS_MAX)."""
+    fine = np.linspace(s_lo, s_hi, int(math.ceil((s_hi - s_lo) / (DS_MAX / 8))) + 1)
+    st = np.empty((fine.size, 2))
+    _sample_kernel(pf, mp, fine, st)
+    chi = fine / DS_MAX + st[:, 1] / DLNS_MAX - st[:, 0] / DLNP_MAX
+    chi = np.maximum.accumulate(chi)
+    n = int(math.ceil(chi[-1] - chi[0])) + 1
+    sn = np.interp(np.linspace(chi[0], chi[-1], n), chi, fine)
+    sn[0], sn[-1] = s_lo, s_hi
+    return np.ascontiguousarray(np.unique(sn))
+
+
+def build(model, pr, check=True):
+    """The :data:`BarusTable` of ``model`` (a SqueezeModel) beside its primitive ``pr``;
+    returns (table, info) with the node count, build time and the measured maximum relative
+    interpolation error of S (``max_rel_err_S``, :func:`measure_error`)."""
+    t0 = _clock.perf_counter()
+    mp = model.mp
+    # the lowest separation a served case reaches: ū∞ at the fast path's highest pressure
+    lnv_lo = np.empty(1)
+    qk.lnv_of_lnp_kernel(model.tab, mp, np.array([fast_limit(model)]), lnv_lo)
+    pf = profile(model, math.exp(lnv_lo[0]))
+    sn = _nodes(pf, mp, max(float(pf.s0), lnv_lo[0] - 2 * DS_MAX), math.log(mp.v_ext) + 1e-9)
+    ns = sn.size
+    ST = np.empty((ns, 4))
+    _nodes_kernel(pf, mp, sn, ST)
+    glx, glw = gauss_legendre(CELL_ORDER)
+    I = np.empty((ns - 1, K_MAX + 1))
+    _cells_kernel(pf, mp, sn, ST, glx, glw, I)
+    R_top0 = float(qk._tail_int(mp.c, math.exp(sn[-1]) + mp.d, math.inf))
+    RHO = np.empty((ns, K_MAX + 1))
+    DRHO = np.empty((ns, K_MAX + 1))
+    _sweep(ST, sn, I, float(mp.u0), R_top0, RHO, DRHO)
+    bt = BarusTable(sn, *_index_map(sn), ST, RHO, DRHO, float(mp.v_ext), float(mp.c),
+                    float(mp.d))
+    info = {"nodes": int(ns), "k_max": K_MAX, "api_fast": API_FAST,
+            "build_seconds": _clock.perf_counter() - t0}
+    if check:
+        info.update(measure_error(model, bt, pf, pr))
+    return bt, info
+
+
+@njit(parallel=True, cache=True)
+def _check_kernel(pf, mp, bt, x0s, cells, glx, glw, c, err):
+    """Relative error of S interpolated at the midpoint of cell i against S at node i + 1
+    (the nodal values) plus ∫_{v_mid}^{v_i+1} P_K(A d)/σ̄ dv' by composite GL (A = API_FAST)."""
+    K = series_order(c, API_FAST)
+    for n in prange(x0s.size):
+        E = np.empty(K + 1)
+        shift(c, API_FAST, K, E)
+        x0 = x0s[n]
+        i = cells[n]
+        sa = 0.5 * (bt.xn[i] + bt.xn[i + 1])
+        sb = bt.xn[i + 1]
+        s_mid, _ = s_value(bt, E, K, x0, math.exp(sa))
+        s_node, _ = s_value(bt, E, K, x0, math.exp(sb))
+        m = 16
+        hw = (sb - sa) / m
+        acc = 0.0
+        for p in range(m):
+            mid = sa + (p + 0.5) * hw
+            for q in range(glx.size):
+                s = mid + 0.5 * hw * glx[q]
+                lp, ls, dlp, dls = _pstate(pf, mp, math.exp(s))
+                a = API_FAST * -math.expm1(lp - x0)
+                pk = 0.0
+                for k in range(K, -1, -1):
+                    pk = pk * a + c[k]
+                acc += 0.5 * hw * glw[q] * math.exp(s - ls) * pk
+        err[n] = abs(s_mid / (s_node + acc) - 1.0)
+
+
+def measure_error(model, bt, pf, pr, n=500, seed=0):
+    """Max relative interpolation error of S at the midpoints of n random cells (x0 random
+    up to the fast path's limit, at least ln π_c of the cell: y <= 1 as on the way down to
+    ū∞), at the largest series the fast path uses (A = API_FAST)."""
+    rng = np.random.default_rng(seed)
+    served = np.flatnonzero(bt.ST[:-1, 0] <= fast_limit(model))
+    cells = np.ascontiguousarray(served[rng.integers(0, served.size, n)])
+    x0s = rng.uniform(pr.xn[0], fast_limit(model), n)
+    x0s = np.ascontiguousarray(np.maximum(x0s, bt.ST[cells, 0]))
+    err = np.empty(n)
+    glx, glw = gauss_legendre(CELL_ORDER)
+    _check_kernel(pf, model.mp, bt, x0s, cells, glx, glw, h_coefficients(), err)
+    return {"max_rel_err_S": float(np.max(err)), "checked_cells": int(n)}
