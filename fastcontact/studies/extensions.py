@@ -53,11 +53,6 @@ def check(kind, axes, fixed, given, problems):
                                   or _given(axes, given, "study", "roelands_z")):
         problems.append("study.viscosity = 'roelands' needs study.roelands_z (the pressure–"
                         "viscosity index) or study.alpha_pv (its initial slope)")
-    alpha = axes.get("alpha_pv")
-    if kind == "squeeze" and alpha is not None and np.any(np.asarray(alpha) > 0) \
-            and fixed.get("times"):
-        problems.append("study.times: ū(t) is not available with alpha_pv > 0 (the Barus "
-                        "squeeze engine returns target times only: use ratios / du)")
 
 
 def _col(rows, name):
@@ -95,17 +90,20 @@ def squeeze_evaluate(tables, rows, theory, fixed, columns, scale, base):
     """``base`` on rows without ``alpha_pv`` (or α = 0); the Barus engine on the others."""
     if "alpha_pv" not in rows:
         return base(tables, rows, theory, fixed, columns, scale)
+    from ..squeeze.tire import squeeze_method
     from ..squeeze.viscosity import squeeze_out_piezo
     from .kinds import _below_errors, _out_of_table_errors
 
     def ext(r):
         ratios = tuple(x for x in fixed["ratios"] if column_name("t_ratio", x) in columns)
         du = tuple(d for d in fixed["du"] if column_name("t_du", d) in columns)
+        times = tuple(t for t in fixed["times"] if column_name("u_at", t) in columns)
         sq = squeeze_out_piezo(tables, p0=_col(r, "p0"), E_star=_col(r, "E_star"),
                                R=_col(r, "R"), eta=_col(r, "eta"), alpha_pv=_col(r, "alpha_pv"),
                                theory=theory,
                                u_start=_col(r, "u_start") if "u_start" in r else None,
-                               ratios=ratios, du=du)
+                               ratios=ratios, du=du, times=times,
+                               method=squeeze_method(round(len(rows) * scale)))
         out = {c: sq[c].to_numpy() for c in columns if c in sq}
         err = _out_of_table_errors(tables, r, sq["out_of_table"].to_numpy(bool))
         pz = _errors(sq["status"], "piezo_limit: alpha_pv (p0 - p_cont) >= 1 at the start: "
