@@ -77,38 +77,43 @@ def _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, T, i):
         T[k, i] = tau * (t_of_z(pr, st, vinf, math.log(r1)) - Ts + A * (S - Ss))
 
 
-@njit(cache=True)
-def _squeeze_case(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, i, out, E):
-    """Case i into row/column i of ``out`` (:data:`~.viscosity.BarusOut`); E: scratch of
-    K_MAX + 1 series coefficients."""
-    x0, tau, A, K, st = _served(pr, sc, c, cs, alpha, h, x_fast, i)
-    if K < 0:
-        _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out)
-        return
-    shift(c, A, K, E)
-    out.tau0[i] = tau
-    vinf, vs, zs, Ts, Ss, ds = _start(pr, bt, st, E, K, x0, cs.us[i] / h)
-    out.u_inf[i] = vinf * h
-    out.u_start[i] = vs * h
-    if not (vs * h > vinf * h):  # a given start at or below ū∞ (as reported, SI)
-        _no_times(out, i, ST_BELOW)
-        out.g_start[i] = math.nan
-        return
-    out.g_start[i] = _rate_factor(A * ds) if A > 0.0 else 1.0
-    out.status[i] = ST_OK
-    _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, out.T, i)
-    if tg.times.size:
-        ic = inverse_constants(pr, st)
-        for k in range(tg.times.size):
-            out.U[k, i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss,
-                                    tg.times[k] / tau, ic) * h
-
-
 @njit(parallel=True, cache=True)
 def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, out, scratch):
+    """The case body inline (a call per case with ~40 arguments cost about as much as the
+    case); stores go to the output arrays taken one per statement before the loop (a store
+    into a record's array inside a prange body is lost in numba 0.6x's parfor lowering)."""
+    T_out = out.T
+    U_out = out.U
+    u_inf = out.u_inf
+    u_start = out.u_start
+    tau0 = out.tau0
+    g_start = out.g_start
+    status = out.status
+    times = tg.times
+    us = cs.us
     for i in prange(cs.p0.size):
-        _squeeze_case(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, i, out,
-                      scratch[get_thread_id()])
+        x0, tau, A, K, st = _served(pr, sc, c, cs, alpha, h, x_fast, i)
+        if K < 0:
+            _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out)
+            continue
+        E = scratch[get_thread_id()]
+        shift(c, A, K, E)
+        tau0[i] = tau
+        vinf, vs, zs, Ts, Ss, ds = _start(pr, bt, st, E, K, x0, us[i] / h)
+        u_inf[i] = vinf * h
+        u_start[i] = vs * h
+        if not (vs * h > vinf * h):  # a given start at or below ū∞ (as reported, SI)
+            _no_times(out, i, ST_BELOW)
+            g_start[i] = math.nan
+            continue
+        g_start[i] = _rate_factor(A * ds) if A > 0.0 else 1.0
+        status[i] = ST_OK
+        _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, T_out, i)
+        if times.size:
+            ic = inverse_constants(pr, st)
+            for k in range(times.size):
+                U_out[k, i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss,
+                                        times[k] / tau, ic) * h
 
 
 @njit(cache=True)
@@ -128,38 +133,42 @@ def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, out, scra
                  borrowed(scratch))
 
 
-@njit(cache=True)
-def _tire_fast_case(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, i, out, E):
-    """Case i into row/column i of ``out`` (:data:`~.tire_piezo.TireOut`); E: scratch."""
-    x0, tau, A, K, st = _served(pr, sc, c, cs, alpha, h, x_fast, i)
-    if K < 0:
-        _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out)
-        return
-    shift(c, A, K, E)
-    vinf, vs, zs, Ts, Ss, ds = _start(pr, bt, st, E, K, x0, cs.us[i] / h)
-    out.u_inf[i] = vinf * h
-    out.u_start[i] = vs * h
-    out.u_trap[i] = math.nan
-    if not (vs * h > vinf * h):
-        for k in range(out.T.shape[0]):
-            out.T[k, i] = math.nan
-        out.u_exit[i] = math.nan
-        out.flf[i] = math.nan
-        out.status[i] = TIRE_BELOW
-        return
-    out.flf[i] = 0.0
-    out.status[i] = TIRE_OK
-    _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, out.T, i)
-    ic = inverse_constants(pr, st)
-    out.u_exit[i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, t_fp[i] / tau,
-                              ic) * h
-
-
 @njit(parallel=True, cache=True)
 def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, out, scratch):
+    """The case body inline, as :func:`_squeeze_par`."""
+    T_out = out.T
+    u_exit = out.u_exit
+    u_inf = out.u_inf
+    u_start = out.u_start
+    u_trap = out.u_trap
+    flf = out.flf
+    status = out.status
+    us = cs.us
+    nT = T_out.shape[0]
     for i in prange(cs.p0.size):
-        _tire_fast_case(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, i, out,
-                        scratch[get_thread_id()])
+        x0, tau, A, K, st = _served(pr, sc, c, cs, alpha, h, x_fast, i)
+        if K < 0:
+            _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out)
+            continue
+        E = scratch[get_thread_id()]
+        shift(c, A, K, E)
+        vinf, vs, zs, Ts, Ss, ds = _start(pr, bt, st, E, K, x0, us[i] / h)
+        u_inf[i] = vinf * h
+        u_start[i] = vs * h
+        u_trap[i] = math.nan
+        if not (vs * h > vinf * h):
+            for k in range(nT):
+                T_out[k, i] = math.nan
+            u_exit[i] = math.nan
+            flf[i] = math.nan
+            status[i] = TIRE_BELOW
+            continue
+        flf[i] = 0.0
+        status[i] = TIRE_OK
+        _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, T_out, i)
+        ic = inverse_constants(pr, st)
+        u_exit[i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, t_fp[i] / tau,
+                              ic) * h
 
 
 @njit(cache=True)

@@ -550,7 +550,7 @@ def _piezo_frame(flat, ratios, du, times, T, U, uinf, ustart, tau0, gs, status, 
     cols.update({"tau0": tau0, "barus_number": flat[4] * flat[0], "rate_factor_start": gs,
                  "piezo_limit": status == ST_PIEZO, "trapped": status == ST_TRAPPED,
                  "out_of_table": status == ST_OUT,
-                 "status": np.array(STATUS)[status]})
+                 "status": pd.Categorical.from_codes(status, categories=list(STATUS))})
     df = pd.DataFrame(cols, copy=False)
     units = {"p0": "Pa", "E_star": "Pa", "R": "m", "eta": "Pa s", "alpha_pv": "1/Pa",
              "u_start": "m", "u_inf": "m", "tau0": "s", "barus_number": "1",
