@@ -18,8 +18,8 @@ y = π_c(v)/π0 = 1 - d,
     S(v) = Σ_j E_j (-1)^j y(v)^j R_j(v),   R_j(v) = π_c(v)^-j ∫_v^∞ π_c(v')^j/σ̄(v') dv'.
 
 The R_j depend on v alone (neither on p0 nor on α): they are tabulated once per (tables,
-theory) on the primitive's fine grid in s = ln v as ρ_j = σ̄ R_j (smooth, O(1)) with their
-exact s-derivatives dρ_j/ds = ρ_j (d ln σ̄/ds - j d ln π_c/ds) - v (cubic Hermite), beside
+theory) on nodes in s = ln v, dense where σ̄ collapses, as ρ_j = σ̄ R_j (smooth, O(1)) with
+their exact s-derivatives dρ_j/ds = ρ_j (d ln σ̄/ds - j d ln π_c/ds) - v (cubic Hermite), beside
 ln π_c and ln σ̄. A case then costs its E_j (O(K²), K ≈ 10 at α p0 = 0.1) and K + 1
 multiply-adds per evaluated separation. Above v_ext (π_c/π0 < e^-40) only j = 0 remains,
 the closed-form flat-film tail of the base primitive. Since every E_j is a sum of positive
@@ -65,9 +65,9 @@ SUB_SPAN = 1.0
 
 #: the tabulated R_j of one (tables, theory): nodes xn in s = ln v (the last one at ln v_ext)
 #: and their locator (blo, bdz, bidx: fractional node index at uniform s samples, as the
-#: primitive's rows, so that its ``_locate`` serves both); ST (ns, 4) = ln π_c, d ln π_c/ds, ln σ̄, d ln σ̄/ds; RHO, DRHO
-#: (ns, K_MAX + 1) = ρ_j = σ̄ R_j and dρ_j/ds; v_ext, c, d: the base primitive's closed-form
-#: tail above v_ext (T there is ∫dy/(y³ - c y), y = v + d)
+#: primitive's rows, so that its ``_locate`` serves both); ST (ns, 4) = ln π_c, d ln π_c/ds,
+#: ln σ̄, d ln σ̄/ds; RHO, DRHO (ns, K_MAX + 1) = ρ_j = σ̄ R_j and dρ_j/ds; v_ext, c, d: the
+#: base primitive's closed-form tail above v_ext (T there is ∫dy/(y³ - c y), y = v + d)
 BarusTable = namedtuple("BarusTable", "xn blo bdz bidx ST RHO DRHO v_ext c d")
 
 
@@ -184,7 +184,6 @@ def u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic):
         return vinf
     target = Ts + A * Ss + tt
     tau = Ts + tt
-    v = vs
     for _ in range(40):
         z = z_of_t_at(pr, st, vinf, tau, ic)
         v = vinf * (1.0 + math.exp(z))
@@ -259,14 +258,6 @@ def _sweep(ST, sn, I, u0, R_top0, RHO, DRHO):
             DRHO[i, j] = RHO[i, j] * (ST[i, 3] - j * ST[i, 1]) - v
 
 
-@njit(parallel=True, cache=True)
-def _sample_kernel(pf, mp, s, out):
-    for i in prange(s.size):
-        lp, ls, dlp, dls = _pstate(pf, mp, math.exp(s[i]))
-        out[i, 0] = lp
-        out[i, 1] = ls
-
-
 #: node spacing: at most DS_MAX in s = ln v, DLNS_MAX in ln σ̄ and DLNP_MAX in ln π_c
 #: (the nodes are uniform in χ = s/DS_MAX + ln σ̄/DLNS_MAX - ln π_c/DLNP_MAX: dense where σ̄
 #: collapses towards percolation, as the primitive's rows)
@@ -278,9 +269,9 @@ DLNP_MAX = 0.2
 def _nodes(pf, mp, s_lo, s_hi):
     """Nodes sn on [s_lo, s_hi], uniform in χ (see DS_MAX)."""
     fine = np.linspace(s_lo, s_hi, int(math.ceil((s_hi - s_lo) / (DS_MAX / 8))) + 1)
-    st = np.empty((fine.size, 2))
-    _sample_kernel(pf, mp, fine, st)
-    chi = fine / DS_MAX + st[:, 1] / DLNS_MAX - st[:, 0] / DLNP_MAX
+    st = np.empty((fine.size, 4))
+    _nodes_kernel(pf, mp, fine, st)
+    chi = fine / DS_MAX + st[:, 2] / DLNS_MAX - st[:, 0] / DLNP_MAX
     chi = np.maximum.accumulate(chi)
     n = int(math.ceil(chi[-1] - chi[0])) + 1
     sn = np.interp(np.linspace(chi[0], chi[-1], n), chi, fine)
