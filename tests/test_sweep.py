@@ -325,3 +325,27 @@ def test_local_cluster_workers_are_fork_safe_and_not_oversubscribed():
     for layer, nthreads, _, omp in got.values():
         assert layer == "workqueue" and nthreads == max(1, cores // 2) and omp == "1"
     assert info["numba_threads_per_worker"] == max(1, cores // 2)
+
+
+def test_worker_preload_drops_only_the_lost_heartbeat():
+    """The workers' preload (run in a child: it changes the process's SIGINT and logging)
+    ignores SIGINT and drops the heartbeat failure a worker logs, with a traceback, when the
+    driver's scheduler closes first; any other worker error still reaches stderr."""
+    code = (
+        "import logging, signal\n"
+        "from fastcontact.studies.sweep import dask_setup\n"
+        "logging.basicConfig(level=logging.ERROR)\n"
+        "dask_setup(None)\n"
+        "log = logging.getLogger('distributed.worker')\n"
+        "try:\n"
+        "    raise OSError('Stream is closed')\n"
+        "except OSError:\n"
+        "    log.exception('Failed to communicate with scheduler during heartbeat.')\n"
+        "    log.exception('Compute Failed')\n"
+        "print(signal.getsignal(signal.SIGINT) is signal.SIG_IGN)\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       env=_env(), timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "True"
+    assert "heartbeat" not in r.stderr
+    assert "Compute Failed" in r.stderr and "OSError: Stream is closed" in r.stderr

@@ -121,12 +121,27 @@ def _read_partition_meta(path):
 
 
 # ============================================================================ cluster
+#: what a worker of :func:`local_cluster` logs when a heartbeat meets a closed scheduler
+_HEARTBEAT_LOST = "Failed to communicate with scheduler during heartbeat"
+
+
+def _not_heartbeat_lost(record):
+    """Logging filter of :func:`dask_setup`: False for the heartbeat-failure record."""
+    return not record.getMessage().startswith(_HEARTBEAT_LOST)
+
+
 def dask_setup(worker):
-    """Worker preload of :func:`local_cluster`: a terminal's Ctrl-C reaches the whole process
-    group; the driver handles it (and stops the workers), so the workers ignore SIGINT
-    instead of printing a KeyboardInterrupt traceback each."""
+    """Worker preload of :func:`local_cluster`.
+
+    A terminal's Ctrl-C reaches the whole process group; the driver handles it (and stops
+    the workers), so the workers ignore SIGINT instead of printing a KeyboardInterrupt
+    traceback each. The scheduler of a local cluster lives in the driver: a worker's
+    heartbeat that meets it closed (the driver is stopping, interrupted or not) is dropped
+    from the worker's log instead of printing a traceback (distributed itself treats it as
+    transient, ``Worker.heartbeat``); the driver reports why it stopped."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+    logging.getLogger("distributed.worker").addFilter(_not_heartbeat_lost)
 
 
 def local_cluster(workers=None):
