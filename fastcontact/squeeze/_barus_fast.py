@@ -16,6 +16,7 @@ from numba import get_thread_id, njit, prange
 from ..kernels.borrow import borrowed
 
 from ._barus_primitive import BarusTable, s_value, series_order, shift, u_at_time
+from ._fastpath import GUARD_Z, _row_col, row_targets
 from ._kernels import Cases, Quad
 from ._primitive_eval import Primitive, inverse_constants, row_value, stencil, t_of_z
 from .tire_piezo import _BELOW as TIRE_BELOW
@@ -24,7 +25,7 @@ from .tire_piezo import TireOut, _tire_case
 from .viscosity import (ST_BELOW, ST_OK, BarusOut, BarusTargets, _case_head, _no_times,
                         _piezo_case, _rate_factor)
 
-__all__ = ["squeeze_kernel", "tire_kernel"]
+__all__ = ["squeeze_kernel", "tire_kernel", "ratio_rows"]
 #: the records' types, by name in this module: numba's parfor lowering rebuilds the kernels'
 #: argument types from the module globals
 _RECORDS = (BarusTable, BarusOut, BarusTargets, Cases, Primitive, Quad, TireOut)
@@ -45,27 +46,40 @@ def _served(pr, sc, c, cs, alpha, h, x_fast, i):
 
 
 @njit(cache=True, inline="always")
-def _start(pr, bt, st, E, K, x0, vs_in):
-    """(v∞, v_start, z_start, T(start), S(start), 1 - π_c/π0 at the start) of a served case;
-    v_start <= v∞ is returned as is (the caller flags it)."""
+def _start(pr, bt, st, E, K, x0, vs_in, lnTs):
+    """(v∞, v_start, z_start, T(start) or -1 (not computed yet), T(start) paired with the
+    row-table targets, S(start), 1 - π_c/π0 at the start) of a served case; v_start <= v∞ is
+    returned as is (the caller flags it). The default start's T comes from the row table
+    ``lnTs`` (as the base fast path's), a given start's from t_of_z."""
     vinf = math.exp(row_value(pr.lnv, st))
     if vs_in != vs_in:
         zs = row_value(pr.zs, st)
         vs = vinf * (1.0 + math.exp(zs))
+        Ts = -1.0
+        Ts_row = math.exp(row_value(lnTs, st))
     else:
         vs = vs_in
         if not (vs > vinf):
-            return vinf, vs, math.nan, math.nan, math.nan, math.nan
+            return vinf, vs, math.nan, math.nan, math.nan, math.nan, math.nan
         if vs == math.inf:
-            return vinf, vs, math.inf, 0.0, 0.0, 1.0
+            return vinf, vs, math.inf, 0.0, 0.0, 0.0, 1.0
         zs = math.log(vs / vinf - 1.0)
+        Ts = t_of_z(pr, st, vinf, zs)
+        Ts_row = Ts
     Ss, lnps = s_value(bt, E, K, x0, vs)
-    return vinf, vs, zs, t_of_z(pr, st, vinf, zs), Ss, -math.expm1(lnps - x0)
+    return vinf, vs, zs, Ts, Ts_row, Ss, -math.expm1(lnps - x0)
 
 
 @njit(cache=True, inline="always")
-def _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, T, i):
-    """Times [s] from the start to each target (ratios × v∞, then v∞ + dv) into column i."""
+def _target_times(pr, bt, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, tg, lnT, T, i):
+    """Times [s] from the start to each target (ratios × v∞, then v∞ + dv) into column i;
+    returns T(start) (computed here if a target needed it, else as given).
+
+    The base part T(target) - T(start): a ratio target more than GUARD_Z below the start
+    from the row table ``lnT`` (:func:`~._fastpath.row_targets`; four loads and an exp, as
+    the base fast path), a target near the start or a Δu target from t_of_z at both ends
+    (one interpolant: the difference stays accurate and >= 0). The Barus part A [S(target)
+    - S(start)] from the correction table."""
     nr = tg.ratios.size
     for k in range(T.shape[0]):
         r1 = tg.ratios[k] - 1.0 if k < nr else tg.dvs[k - nr] / vinf
@@ -74,11 +88,20 @@ def _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, T, i):
             T[k, i] = 0.0
             continue
         S, _ = s_value(bt, E, K, x0, vt)
-        T[k, i] = tau * (t_of_z(pr, st, vinf, math.log(r1)) - Ts + A * (S - Ss))
+        z = math.log(r1)
+        if k < nr and z < zs - GUARD_Z:
+            dT = math.exp(_row_col(lnT, st, k)) - Ts_row
+        else:
+            if Ts < 0.0:
+                Ts = t_of_z(pr, st, vinf, zs)
+            dT = t_of_z(pr, st, vinf, z) - Ts
+        T[k, i] = tau * (dT + A * (S - Ss))
+    return Ts
 
 
 @njit(parallel=True, cache=True)
-def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, out, scratch):
+def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, lnT, lnTs, quad, out,
+                 scratch):
     """The case body inline (a call per case with ~40 arguments cost about as much as the
     case); stores go to the output arrays taken one per statement before the loop (a store
     into a record's array inside a prange body is lost in numba 0.6x's parfor lowering)."""
@@ -99,7 +122,7 @@ def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, out, scratc
         E = scratch[get_thread_id()]
         shift(c, A, K, E)
         tau0[i] = tau
-        vinf, vs, zs, Ts, Ss, ds = _start(pr, bt, st, E, K, x0, us[i] / h)
+        vinf, vs, zs, Ts, Ts_row, Ss, ds = _start(pr, bt, st, E, K, x0, us[i] / h, lnTs)
         u_inf[i] = vinf * h
         u_start[i] = vs * h
         if not (vs * h > vinf * h):  # a given start at or below ū∞ (as reported, SI)
@@ -108,8 +131,11 @@ def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, out, scratc
             continue
         g_start[i] = _rate_factor(A * ds) if A > 0.0 else 1.0
         status[i] = ST_OK
-        _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, T_out, i)
+        Ts = _target_times(pr, bt, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, tg,
+                           lnT, T_out, i)
         if times.size:
+            if Ts < 0.0:
+                Ts = t_of_z(pr, st, vinf, zs)
             ic = inverse_constants(pr, st)
             for k in range(times.size):
                 U_out[k, i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss,
@@ -117,11 +143,11 @@ def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, out, scratc
 
 
 @njit(cache=True)
-def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, out, scratch):
+def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, rows, quad, out, scratch):
     """Barus squeeze-out of every case (``cs`` :class:`~._kernels.Cases`, α [1/Pa] apart)
     into ``out`` (:data:`~.viscosity.BarusOut`): the primitive where it serves the case, else
     the per-case quadrature (``quad``). ``scratch`` (threads, K_MAX + 1): one row of series
-    coefficients per thread.
+    coefficients per thread. ``rows``: :func:`ratio_rows` of ``tg``.
 
     The records reach the per-case helper as borrowed views (:mod:`fastcontact.kernels.borrow`;
     passed by value each call costs two contended atomic reference counts per array, most of
@@ -129,12 +155,13 @@ def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, quad, out, scra
     numba's parfor lowering rebuilds a namedtuple captured by a prange body from the
     definition of its variable, which must be an argument or the class itself."""
     _squeeze_par(borrowed(tab), borrowed(sc), borrowed(pr), borrowed(bt), borrowed(c), x_fast,
-                 borrowed(cs), borrowed(alpha), h, borrowed(tg), borrowed(quad), borrowed(out),
-                 borrowed(scratch))
+                 borrowed(cs), borrowed(alpha), h, borrowed(tg), borrowed(rows.lnT),
+                 borrowed(rows.lnTs), borrowed(quad), borrowed(out), borrowed(scratch))
 
 
 @njit(parallel=True, cache=True)
-def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, out, scratch):
+def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, lnT, lnTs, quad, out,
+              scratch):
     """The case body inline, as :func:`_squeeze_par`."""
     T_out = out.T
     u_exit = out.u_exit
@@ -152,7 +179,7 @@ def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, out, scr
             continue
         E = scratch[get_thread_id()]
         shift(c, A, K, E)
-        vinf, vs, zs, Ts, Ss, ds = _start(pr, bt, st, E, K, x0, us[i] / h)
+        vinf, vs, zs, Ts, Ts_row, Ss, ds = _start(pr, bt, st, E, K, x0, us[i] / h, lnTs)
         u_inf[i] = vinf * h
         u_start[i] = vs * h
         u_trap[i] = math.nan
@@ -165,17 +192,30 @@ def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, out, scr
             continue
         flf[i] = 0.0
         status[i] = TIRE_OK
-        _target_times(pr, bt, st, E, K, x0, A, vinf, vs, Ts, Ss, tau, tg, T_out, i)
+        Ts = _target_times(pr, bt, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, tg,
+                           lnT, T_out, i)
+        if Ts < 0.0:
+            Ts = t_of_z(pr, st, vinf, zs)
         ic = inverse_constants(pr, st)
         u_exit[i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, t_fp[i] / tau,
                               ic) * h
 
 
 @njit(cache=True)
-def tire_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, quad, out, scratch):
+def tire_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, rows, quad, out, scratch):
     """Barus tire footprint of every case (footprint time t_fp [s] apart) into ``out``
     (:data:`~.tire_piezo.TireOut`): targets and ū at t_fp from the primitive where it serves
     the case, else the per-case quadrature (records borrowed as in :func:`squeeze_kernel`)."""
     _tire_par(borrowed(tab), borrowed(sc), borrowed(pr), borrowed(bt), borrowed(c), x_fast,
-              borrowed(cs), borrowed(alpha), borrowed(t_fp), h, borrowed(tg), borrowed(quad),
-              borrowed(out), borrowed(scratch))
+              borrowed(cs), borrowed(alpha), borrowed(t_fp), h, borrowed(tg),
+              borrowed(rows.lnT), borrowed(rows.lnTs), borrowed(quad), borrowed(out),
+              borrowed(scratch))
+
+
+def ratio_rows(pr, tg):
+    """The base fast path's row tables (:func:`~._fastpath.row_targets`, ~1 ms) of the ratio
+    targets of ``tg`` (:data:`~.viscosity.BarusTargets`, whose first ratio is t_star's 1.01):
+    ln T at each ratio target and at the default start, per row of the primitive ``pr``."""
+    if tg.ratios.size == 0 or tg.ratios[0] != 1.01:
+        raise ValueError("the Barus targets must start with t_star's ratio 1.01")
+    return row_targets(pr, tg.ratios[1:])

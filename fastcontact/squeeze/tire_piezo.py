@@ -125,14 +125,16 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
         p, E, R, eta, al, u0, tf = [np.ascontiguousarray(a, dtype=np.float64) for a in
                                     (p_eval[sel], b["E_star"][sel], b["R"][sel], b["eta"][sel],
                                      alpha[sel], us_in, t_fp[sel])]
-        args = (Cases(p, E, R, eta, u0), al, tf, h, BarusTargets(vr, dv, np.empty(0)),
-                Quad(x, w, QUAD_WIDTH), TireOut(T, ue, ui, us, ut, fl, st))
+        cs, tg = Cases(p, E, R, eta, u0), BarusTargets(vr, dv, np.empty(0))
+        quad, res = Quad(x, w, QUAD_WIDTH), TireOut(T, ue, ui, us, ut, fl, st)
         tab, sc = tables.kernel_data(theory), _scalars(tables, theory, None)
         if method == "fast":
-            from ._barus_fast import tire_kernel
-            tire_kernel(tab, sc, *fast_setup(tables, theory, None), *args, fast_scratch())
+            from ._barus_fast import ratio_rows, tire_kernel
+            setup = fast_setup(tables, theory, None)
+            tire_kernel(tab, sc, *setup, cs, al, tf, h, tg, ratio_rows(setup[0], tg), quad, res,
+                        fast_scratch())
         else:
-            _tire_kernel(tab, sc, *args)
+            _tire_kernel(tab, sc, cs, al, tf, h, tg, quad, res)
     with np.errstate(invalid="ignore"):
         piezo = {"u_inf": ui, "u_start": us, "t_du": T[1 + r.size], "t_star": T[0],
                  "trapped": st == _TRAPPED, "u_trap": ut, "fluid_load_fraction": fl,

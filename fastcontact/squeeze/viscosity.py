@@ -473,14 +473,15 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     status = np.empty(n, dtype=np.int8)
     x, w = gauss_legendre(qo)
     cs = Cases(flat[0], flat[1], flat[2], flat[3], flat[5])
-    args = (cs, flat[4], h, BarusTargets(vr, dv, times), Quad(x, w, width),
-            BarusOut(T, U, uinf, ustart, tau0, gs, status))
+    tg = BarusTargets(vr, dv, times)
+    quad, out = Quad(x, w, width), BarusOut(T, U, uinf, ustart, tau0, gs, status)
     if method == "fast":
-        from ._barus_fast import squeeze_kernel
-        squeeze_kernel(tables.kernel_data(theory), sc, *fast_setup(tables, theory, sigma_trap),
-                       *args, fast_scratch())
+        from ._barus_fast import ratio_rows, squeeze_kernel
+        setup = fast_setup(tables, theory, sigma_trap)
+        squeeze_kernel(tables.kernel_data(theory), sc, *setup, cs, flat[4], h, tg,
+                       ratio_rows(setup[0], tg), quad, out, fast_scratch())
     else:
-        _piezo_kernel(tables.kernel_data(theory), sc, *args)
+        _piezo_kernel(tables.kernel_data(theory), sc, cs, flat[4], h, tg, quad, out)
     df = _piezo_frame(flat, ratios, du, times, T, U, uinf, ustart, tau0, gs, status, theory,
                       method)
     if method == "fast":
