@@ -3,7 +3,8 @@
 Uniform ring: ``q L = ∫_{p_b}^{p_a} σ0(p0 - p) η0/η(p) dp`` by composite Gauss–Legendre in
 ln p_cont (Barus is the p_r = 0 case of the Roelands weight). Hertz O-ring: shooting on
 k = 12 η0 q / h³ with RK4 on steps graded towards both zone ends, in the reduced pressure ψ
-(Barus) or in p_f itself (Roelands), bracketed Illinois iteration in ln k. The wrapper and
+(Barus) or in p_f itself (Roelands), bracketed secant iteration in k started from the root of
+a coarse (25-step) shooting. The wrapper and
 the equations: :mod:`fastcontact.seal.viscosity`. ``sc`` is the scalar record of
 :func:`fastcontact.seal.viscosity._scalars` (read as ``sc[0].x_lo``).
 """
@@ -203,56 +204,113 @@ def _mismatch(tab, sc, cs, roelands, y, n):
     return _shoot(tab, sc, cs, math.exp(y), n)
 
 
+#: nodes of the start estimate of :func:`_solve_k` (midpoints in the graded t of the shooting)
+START_NODES = 24
+
+
 @njit(cache=True)
-def _solve_k(tab, sc, cs, roelands, n):
-    """(k, converged) of one Hertz case ``cs`` (:class:`HertzCase`), k = 12 η0 q / h³ [Pa/m]:
-    bracket the outlet condition in ln k, starting from the pressure scale (ψ_a for Barus,
-    p_a − p_b for Roelands) over the resistance of the dry profile, then Illinois (regula
-    falsi)."""
+def _k_start(tab, sc, cs, roelands):
+    """First k of the shooting: the pressure scale over the resistance along a straight-line
+    guess of the solution (Barus: ∫ a sin θ/σ̄ dθ with ψ falling linearly in t from ψ_a to 0;
+    Roelands: ∫ a sin θ (η/η0)/σ̄ dθ with p_f falling linearly from p_a to p_b), midpoint rule
+    on the graded t of :func:`_shoot` (START_NODES nodes). Falls back to the resistance at the
+    mid pressure where the guess meets an open pocket or percolation."""
     pH, pa, pb = cs.pH, cs.pa, cs.pb
     scale = pa - pb if roelands else cs.psi_a
-    smid = _sigma(tab, sc, math.log(max(pH - 0.5 * (pa + pb), 1e-300) / cs.E))
-    y = math.log(scale * max(smid, 1e-300) / (2.0 * cs.a))
-    f = _mismatch(tab, sc, cs, roelands, y, n)
-    lo = y
-    hi = y
-    flo = f
-    fhi = f
-    step = 2.0
-    for _ in range(400):
-        if flo > 0.0 and fhi < 0.0:
+    span = cs.span
+    w = 0.0
+    for m in range(START_NODES):
+        t = (m + 0.5) / START_NODES
+        th = cs.th_s + span * t * t * (3.0 - 2.0 * t)
+        if roelands:   # p_f linear in t; dp_f/dθ carries η/η0
+            p = pa + (pb - pa) * t
+            visc = math.exp(_ln_eta(p - pb, cs.A, cs.Z, cs.pr))
+        else:          # ψ linear in t; dψ/dθ carries no viscosity
+            p = _pf(scale * (1.0 - t), pb, cs.alpha)
+            visc = 1.0
+        sg = _pocket_sigma(tab, sc, pH * math.sin(th) - p, cs.E)
+        if not (sg > 0.0):
+            w = -1.0
             break
+        w += cs.a * math.sin(th) * visc / sg * span * 6.0 * t * (1.0 - t) / START_NODES
+    if not (w > 0.0 and w < math.inf):
+        smid = _sigma(tab, sc, math.log(max(pH - 0.5 * (pa + pb), 1e-300) / cs.E))
+        return scale * max(smid, 1e-300) / (2.0 * cs.a)
+    return scale / w
+
+
+#: RK4 steps of the coarse shooting that starts the fine one in :func:`_solve_k`
+COARSE_STEPS = 25
+
+
+@njit(cache=True)
+def _secant(tab, sc, cs, roelands, n, k, slope, tol):
+    """(k, converged, slope) of the shooting with n steps: the root of the outlet value f(k)
+    (:func:`_mismatch`) from k; ``slope`` an estimate of f'(k) for the first step (> 0 or NaN:
+    none, the chord through (0, f(0)) instead), the slope of the last two points returned.
+
+    f falls with k from f(0) = the pressure scale (ψ_a for Barus, p_a − p_b for Roelands: no
+    flux, no drop); a k far above the root makes the shot run away (f = −10 × scale,
+    "clamped"). Secant steps through the last two unclamped points inside a bracket
+    [k_lo, k_hi] with f(k_lo) > 0 > f(k_hi) that every shot narrows; a step leaving the
+    bracket is replaced by doubling k (no upper end yet) or by bisection in ln k. Converged
+    when |f| <= tol × scale or a step changes k by <= tol × k."""
+    scale = cs.pa - cs.pb if roelands else cs.psi_a
+    klo, khi = 0.0, math.inf
+    k1, f1 = 0.0, scale                       # the last two unclamped points
+    k2, f2 = math.nan, math.nan
+    first = slope < 0.0
+    for _ in range(200):
+        f = _mismatch(tab, sc, cs, roelands, math.log(k), n)
+        if not (f == f):
+            return math.nan, False, math.nan
         if f > 0.0:
-            hi = lo + step
-            fhi = _mismatch(tab, sc, cs, roelands, hi, n)
-            if fhi > 0.0:
-                lo, flo = hi, fhi
+            klo = k
         else:
-            lo = hi - step
-            flo = _mismatch(tab, sc, cs, roelands, lo, n)
-            if flo < 0.0:
-                hi, fhi = lo, flo
-        f = flo if flo > 0.0 else fhi
-        step *= 1.5
-    if not (flo > 0.0 and fhi < 0.0):
-        return math.nan, False
-    side = 0
-    for _ in range(200):                      # Illinois (regula falsi) in ln k
-        y = (lo * fhi - hi * flo) / (fhi - flo)
-        f = _mismatch(tab, sc, cs, roelands, y, n)
-        if f > 0.0:
-            lo, flo = y, f
-            if side == 1:
-                fhi *= 0.5
-            side = 1
+            khi = k
+        if f > -9.999999 * scale:             # not clamped: a point of the secant
+            k2, f2 = k1, f1
+            k1, f1 = k, f
+        if first:                             # Newton with the given slope
+            kn = k - f / slope
+            first = False
         else:
-            hi, fhi = y, f
-            if side == -1:
-                flo *= 0.5
-            side = -1
-        if hi - lo < 1e-13 or abs(f) <= 1e-14 * scale:
-            return math.exp(y), True
-    return math.exp(y), False
+            kn = k1 - f1 * (k1 - k2) / (f1 - f2) if f1 != f2 else math.nan
+        if abs(f) <= tol * scale:
+            return k, True, (f1 - f2) / (k1 - k2)
+        if not (klo < kn < khi):
+            if khi == math.inf:
+                kn = 2.0 * k
+            elif klo == 0.0:
+                kn = 0.5 * khi
+            else:
+                kn = math.sqrt(klo * khi)
+        if abs(kn - k) <= tol * k:
+            return kn, True, (f1 - f2) / (k1 - k2)
+        k = kn
+    return k, False, math.nan
+
+
+@njit(cache=True)
+def _solve_k(tab, sc, cs, roelands, n):
+    """(k, converged) of one Hertz case ``cs`` (:class:`HertzCase`), k = 12 η0 q / h³ [Pa/m].
+
+    The root of the n-step shooting (:func:`_secant`, to 1e-13), started at the root of the
+    same shooting with COARSE_STEPS steps (from :func:`_k_start`, to 1e-10) and that root's
+    slope: the coarse solve costs about one fine shot, and the fine one then takes ~3–4 shots
+    instead of ~10 from the straight-line start (strong contact feedback makes f(k) concave
+    and the first steps overshoot into runaway shots)."""
+    k0 = _k_start(tab, sc, cs, roelands)
+    if n > 2 * COARSE_STEPS:
+        kc, okc, slope = _secant(tab, sc, cs, roelands, COARSE_STEPS, k0, math.nan, 1e-10)
+        if okc and kc > 0.0 and kc < math.inf:
+            k0 = kc
+        else:
+            slope = math.nan
+    else:
+        slope = math.nan
+    k, ok, _ = _secant(tab, sc, cs, roelands, n, k0, slope, 1e-13)
+    return k, ok
 
 
 @njit(cache=True)

@@ -11,7 +11,8 @@ conductivity σ0 at the outlet viscosity η0 and the reduced pressure
   ``q = (1/L)∫σ_eff dp``). Evaluated by Gauss–Legendre in ln p_cont on the tables.
 * **Hertz O-ring** (p0(x) = p_H √(1 - ((x-a)/a)²)): dψ/dx = -q/σ0(p0(x) - p_f(ψ)) has no
   closed form; it is solved by shooting on q (RK4 in θ, x = a(1 - cos θ), on steps
-  graded towards both zone ends, bracketed Illinois iteration on ln q) over the sealing zone p0(x) >= p_f.
+  graded towards both zone ends; bracketed secant iteration on q, started from the root of a
+  25-step shooting) over the sealing zone p0(x) >= p_f.
 
 In both, ``p_f(ψ) = p_b - ln(1 - αψ)/α``; ψ < 1/α always since ψ_a = ψ(p_a) < 1/α.
 
