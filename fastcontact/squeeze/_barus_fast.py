@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import get_thread_id, njit, prange
 
 from ..kernels.borrow import borrowed
 
 from ._barus_primitive import BarusTable, s_value, series_order, shift, u_at_time
-from ._fastpath import GUARD_Z, _row_col, row_targets
+from ._fastpath import ZTargets, _target_time, row_targets
 from ._kernels import Cases, Quad
 from ._primitive_eval import Primitive, inverse_constants, row_value, stencil, t_of_z
 from .tire_piezo import _BELOW as TIRE_BELOW
@@ -28,7 +29,7 @@ from .viscosity import (ST_BELOW, ST_OK, BarusOut, BarusTargets, _case_head, _no
 __all__ = ["squeeze_kernel", "tire_kernel", "ratio_rows"]
 #: the records' types, by name in this module: numba's parfor lowering rebuilds the kernels'
 #: argument types from the module globals
-_RECORDS = (BarusTable, BarusOut, BarusTargets, Cases, Primitive, Quad, TireOut)
+_RECORDS = (BarusTable, BarusOut, BarusTargets, Cases, Primitive, Quad, TireOut, ZTargets)
 
 
 @njit(cache=True, inline="always")
@@ -71,36 +72,28 @@ def _start(pr, bt, st, E, K, x0, vs_in, lnTs):
 
 
 @njit(cache=True, inline="always")
-def _target_times(pr, bt, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, tg, lnT, T, i):
-    """Times [s] from the start to each target (ratios × v∞, then v∞ + dv) into column i;
-    returns T(start) (computed here if a target needed it, else as given).
+def _target_times(bt, pr, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt, T, i):
+    """Times [s] from the start to each target (t_star and the ratios × v∞, then v∞ + dv;
+    ``zt`` the :data:`~._fastpath.ZTargets` of :func:`ratio_rows`) into column i; returns
+    T(start) (computed here if a target needed it, else as given).
 
-    The base part T(target) - T(start): a ratio target more than GUARD_Z below the start
-    from the row table ``lnT`` (:func:`~._fastpath.row_targets`; four loads and an exp, as
-    the base fast path), a target near the start or a Δu target from t_of_z at both ends
-    (one interpolant: the difference stays accurate and >= 0). The Barus part A [S(target)
-    - S(start)] from the correction table."""
-    nr = tg.ratios.size
+    The base part T(target) - T(start) is the base fast path's
+    (:func:`~._fastpath._target_time`: row tables far below the start, the interpolant at
+    both ends near it); the Barus part A [S(target) - S(start)] from the correction table."""
+    nr = zt.r1s.size
     for k in range(T.shape[0]):
-        r1 = tg.ratios[k] - 1.0 if k < nr else tg.dvs[k - nr] / vinf
-        vt = vinf * (1.0 + r1)
+        vt = vinf * (1.0 + (zt.r1s[k] if k < nr else zt.dvs[k - nr] / vinf))
         if vt >= vs:
             T[k, i] = 0.0
             continue
         S, _ = s_value(bt, E, K, x0, vt)
-        z = math.log(r1)
-        if k < nr and z < zs - GUARD_Z:
-            dT = math.exp(_row_col(lnT, st, k)) - Ts_row
-        else:
-            if Ts < 0.0:
-                Ts = t_of_z(pr, st, vinf, zs)
-            dT = t_of_z(pr, st, vinf, z) - Ts
-        T[k, i] = tau * (dT + A * (S - Ss))
+        dt, Ts = _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, zt)
+        T[k, i] = dt + tau * A * (S - Ss)
     return Ts
 
 
 @njit(parallel=True, cache=True)
-def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, lnT, lnTs, quad, out,
+def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, quad, out,
                  scratch):
     """The case body inline (a call per case with ~40 arguments cost about as much as the
     case); stores go to the output arrays taken one per statement before the loop (a store
@@ -131,8 +124,8 @@ def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, lnT, lnTs, quad, 
             continue
         g_start[i] = _rate_factor(A * ds) if A > 0.0 else 1.0
         status[i] = ST_OK
-        Ts = _target_times(pr, bt, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, tg,
-                           lnT, T_out, i)
+        Ts = _target_times(bt, pr, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt,
+                           T_out, i)
         if times.size:
             if Ts < 0.0:
                 Ts = t_of_z(pr, st, vinf, zs)
@@ -143,11 +136,12 @@ def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, lnT, lnTs, quad, 
 
 
 @njit(cache=True)
-def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, rows, quad, out, scratch):
+def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, quad, out,
+                   scratch):
     """Barus squeeze-out of every case (``cs`` :class:`~._kernels.Cases`, α [1/Pa] apart)
     into ``out`` (:data:`~.viscosity.BarusOut`): the primitive where it serves the case, else
     the per-case quadrature (``quad``). ``scratch`` (threads, K_MAX + 1): one row of series
-    coefficients per thread. ``rows``: :func:`ratio_rows` of ``tg``.
+    coefficients per thread. ``zt``, ``lnTs``: :func:`ratio_rows` of ``tg``.
 
     The records reach the per-case helper as borrowed views (:mod:`fastcontact.kernels.borrow`;
     passed by value each call costs two contended atomic reference counts per array, most of
@@ -155,12 +149,12 @@ def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, rows, quad, out
     numba's parfor lowering rebuilds a namedtuple captured by a prange body from the
     definition of its variable, which must be an argument or the class itself."""
     _squeeze_par(borrowed(tab), borrowed(sc), borrowed(pr), borrowed(bt), borrowed(c), x_fast,
-                 borrowed(cs), borrowed(alpha), h, borrowed(tg), borrowed(rows.lnT),
-                 borrowed(rows.lnTs), borrowed(quad), borrowed(out), borrowed(scratch))
+                 borrowed(cs), borrowed(alpha), h, borrowed(tg), borrowed(zt), borrowed(lnTs),
+                 borrowed(quad), borrowed(out), borrowed(scratch))
 
 
 @njit(parallel=True, cache=True)
-def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, lnT, lnTs, quad, out,
+def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, quad, out,
               scratch):
     """The case body inline, as :func:`_squeeze_par`."""
     T_out = out.T
@@ -192,8 +186,8 @@ def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, lnT, lnTs, qua
             continue
         flf[i] = 0.0
         status[i] = TIRE_OK
-        Ts = _target_times(pr, bt, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, tg,
-                           lnT, T_out, i)
+        Ts = _target_times(bt, pr, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt,
+                           T_out, i)
         if Ts < 0.0:
             Ts = t_of_z(pr, st, vinf, zs)
         ic = inverse_constants(pr, st)
@@ -202,20 +196,24 @@ def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, lnT, lnTs, qua
 
 
 @njit(cache=True)
-def tire_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, rows, quad, out, scratch):
+def tire_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, quad, out,
+                scratch):
     """Barus tire footprint of every case (footprint time t_fp [s] apart) into ``out``
     (:data:`~.tire_piezo.TireOut`): targets and ū at t_fp from the primitive where it serves
     the case, else the per-case quadrature (records borrowed as in :func:`squeeze_kernel`)."""
     _tire_par(borrowed(tab), borrowed(sc), borrowed(pr), borrowed(bt), borrowed(c), x_fast,
-              borrowed(cs), borrowed(alpha), borrowed(t_fp), h, borrowed(tg),
-              borrowed(rows.lnT), borrowed(rows.lnTs), borrowed(quad), borrowed(out),
-              borrowed(scratch))
+              borrowed(cs), borrowed(alpha), borrowed(t_fp), h, borrowed(tg), borrowed(zt),
+              borrowed(lnTs), borrowed(quad), borrowed(out), borrowed(scratch))
 
 
 def ratio_rows(pr, tg):
-    """The base fast path's row tables (:func:`~._fastpath.row_targets`, ~1 ms) of the ratio
-    targets of ``tg`` (:data:`~.viscosity.BarusTargets`, whose first ratio is t_star's 1.01):
-    ln T at each ratio target and at the default start, per row of the primitive ``pr``."""
+    """(zt, lnTs): the base fast path's target record (:data:`~._fastpath.ZTargets`: ū/ū∞ - 1
+    of t_star and the ratios, their logs, the Δu targets, ln T at each ratio target per row
+    of the primitive ``pr``, :func:`~._fastpath.row_targets`, ~1 ms) and ln T at the default
+    start per row, for ``tg`` (:data:`~.viscosity.BarusTargets`, whose first ratio is
+    t_star's 1.01)."""
     if tg.ratios.size == 0 or tg.ratios[0] != 1.01:
         raise ValueError("the Barus targets must start with t_star's ratio 1.01")
-    return row_targets(pr, tg.ratios[1:])
+    rt = row_targets(pr, tg.ratios[1:])
+    r1s = np.ascontiguousarray(np.concatenate(([0.01], tg.ratios[1:] - 1.0)))
+    return ZTargets(r1s, np.log(r1s), tg.dvs, rt.lnT), rt.lnTs

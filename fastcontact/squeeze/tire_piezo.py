@@ -131,7 +131,7 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
         if method == "fast":
             from ._barus_fast import ratio_rows, tire_kernel
             setup = fast_setup(tables, theory, None)
-            tire_kernel(tab, sc, *setup, cs, al, tf, h, tg, ratio_rows(setup[0], tg), quad, res,
+            tire_kernel(tab, sc, *setup, cs, al, tf, h, tg, *ratio_rows(setup[0], tg), quad, res,
                         fast_scratch())
         else:
             _tire_kernel(tab, sc, cs, al, tf, h, tg, quad, res)
