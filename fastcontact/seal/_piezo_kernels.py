@@ -246,7 +246,7 @@ COARSE_STEPS = 25
 @njit(cache=True)
 def _secant(tab, sc, cs, roelands, n, k, slope, tol):
     """(k, converged, slope) of the shooting with n steps: the root of the outlet value f(k)
-    (:func:`_mismatch`) from k; ``slope`` an estimate of f'(k) for the first step (> 0 or NaN:
+    (:func:`_mismatch`) from k; ``slope`` an estimate of f'(k) for the first step (< 0, or NaN:
     none, the chord through (0, f(0)) instead), the slope of the last two points returned.
 
     f falls with k from f(0) = the pressure scale (ψ_a for Barus, p_a − p_b for Roelands: no
