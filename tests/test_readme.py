@@ -29,3 +29,19 @@ def test_readme_example_runs(i, tmp_path):
     res = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True,
                          timeout=600)
     assert res.returncode == 0, f"README block {i} failed:\n{BLOCKS[i]}\n--- stderr ---\n{res.stderr[-3000:]}"
+
+
+def test_suite_runs_without_pytest_xdist():
+    """pyproject's addopts ask pytest-xdist for every core (``-n auto --dist loadfile``);
+    with pytest alone (here: the plugin disabled) the suite must still start, in one process,
+    and say so, not stop at "unrecognized arguments: -n" (tests/conftest.py)."""
+    root = README.parent
+    res = subprocess.run([sys.executable, "-m", "pytest", "-p", "no:xdist", "--collect-only",
+                          "-q", "tests/test_readme.py"], cwd=root, capture_output=True, text=True,
+                         timeout=300)
+    assert res.returncode == 0, res.stdout[-2000:] + res.stderr[-2000:]
+    assert "test_suite_runs_without_pytest_xdist" in res.stdout
+    res = subprocess.run([sys.executable, "-m", "pytest", "-p", "no:xdist", "--co",
+                          "tests/test_readme.py"], cwd=root, capture_output=True, text=True,
+                         timeout=300)
+    assert "pytest-xdist is not loaded: the tests run in one process" in res.stdout
