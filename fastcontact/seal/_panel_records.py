@@ -13,9 +13,10 @@ __all__ = ["Zone", "State", "Work", "Mesh"]
 
 
 class Zone(NamedTuple):
-    """The sealing zone of one case (one argument instead of six): profile kind (0 Hertz,
+    """The sealing zone of one case (one argument instead of seven): profile kind (0 Hertz,
     1 array), zone parameters gp (:func:`._mesh.zone_params`), the array profile's samples
-    xg, pg, and the reduced pressures π_a, π_b at the ends."""
+    xg, pg, the reduced pressures π_a, π_b at the ends, and the fluid's reduced Barus
+    coefficient α̃ = α_pv E* (0: constant viscosity; :mod:`._panels`)."""
 
     kind: int
     gp: np.ndarray
@@ -23,6 +24,7 @@ class Zone(NamedTuple):
     pg: np.ndarray
     pia: float
     pib: float
+    al: float
 
 
 class State(NamedTuple):

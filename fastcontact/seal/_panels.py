@@ -12,6 +12,17 @@ a Sherman–Morrison update for W). Panels whose Legendre tail of r exceeds ``to
 halved and the solution re-converged. Leak rate per unit length: q = (Δp/W) h³E*/(12ηℓ).
 Next to percolation a failed Newton is continued in p_a from an easier problem
 (:func:`solve_robust`). ``rule`` is the flat record :class:`fastcontact.seal.context.PanelRule`.
+
+Barus fluid, η = η0 e^{α(p_f − p_b)} (issue 14; zone field ``al`` = α̃ = α E* > 0): the flux
+is constant along the zone in the reduced pressure ψ = (1 − e^{−α(p_f − p_b)})/α, so R̃/W is
+the remaining fraction of ψ_a = (1 − e^{−α Δp})/α, not of Δp, and
+
+    F_i = (p0_i − p_b) − c_i − P(ψ_a R̃_i / W),   P(ψ) = −ln(1 − α̃ ψ)/α̃,
+
+with q = (ψ_a/W) h³E*/(12η0ℓ). The Newton matrix is the constant-viscosity one with row i's
+coupling multiplied by P'(ψ_i) = 1/(1 − α̃ ψ_i) (exact; α̃ = 0 is the base solver, bit for
+bit). The contact pressure c = p0 − p_f is still the unknown, so σ̄ sees the fluid
+pressure's feedback exactly as in the base engine.
 """
 from __future__ import annotations
 
@@ -25,17 +36,41 @@ from ._mesh import (array_zone, geometry, interp_series, panel_series, remaining
 from ._panel_records import Mesh, State, Work, Zone, _work
 from ._sigma import sig_d
 
-__all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "ST_OK", "ST_NOT_REFINED",
-           "ST_NEWTON_FAILED", "ST_NO_ZONE", "Zone", "State", "Work", "Mesh"]
+__all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "psi_drop", "ST_OK",
+           "ST_NOT_REFINED", "ST_NEWTON_FAILED", "ST_NO_ZONE", "Zone", "State", "Work", "Mesh"]
 
 #: status codes of solve_case
 ST_OK, ST_NOT_REFINED, ST_NEWTON_FAILED, ST_NO_ZONE = 0, 1, 2, 3
 
 
+@njit(cache=True, inline="always")
+def psi_drop(dpi, al):
+    """ψ_a = (1 − e^{−α̃ Δπ})/α̃ of a reduced pressure drop Δπ (Δπ itself for α̃ = 0)."""
+    if al == 0.0:
+        return dpi
+    return -math.expm1(-al * dpi) / al
+
+
+@njit(cache=True, inline="always")
+def _fluid(psi, al):
+    """The fluid pressure above the outlet, π_f − π_b = −ln(1 − α̃ψ)/α̃, of a reduced ψ."""
+    if al == 0.0:
+        return psi
+    return -math.log1p(-al * psi) / al
+
+
+@njit(cache=True, inline="always")
+def _remaining(dpf, psia, al):
+    """The remaining fraction ψ/ψ_a of a fluid pressure π_f − π_b = dpf (dpf/Δπ for α̃ = 0)."""
+    if al == 0.0:
+        return dpf / psia
+    return -math.expm1(-al * dpf) / al / psia
+
+
 @njit(cache=True)
 def _fill_nodes(zone, rule, wk, P):
     """Nodes t, ξ, dξ/dt, e_a, e_b of the P panels of wk.pan."""
-    kind, gp, xg, pg, pia, pib = zone
+    kind, gp, xg, pg, pia, pib = zone.kind, zone.gp, zone.xg, zone.pg, zone.pia, zone.pib
     m, n, zl, pan = rule.m, rule.n, rule.zl, wk.pan
     t, xi, dxi, ea, eb = wk.t, wk.xi, wk.dxi, wk.ea, wk.eb
     for p in range(P):
@@ -49,9 +84,10 @@ def _fill_nodes(zone, rule, wk, P):
 
 
 @njit(cache=True)
-def _resid(tab, sc, rule, st, dxi, eb, dpi, pan, P):
+def _resid(tab, sc, rule, st, dxi, eb, dpi, al, pan, P):
     """r = dξ/dt / σ̄(c), D = dr/dc, R̃ and F at c (the :class:`State` st) on the mesh pan;
     returns (W, max|F|, ok). Not the whole :class:`Work`: it is called per line-search step.
+    ``dpi`` is ψ_a (= Δπ for a constant viscosity, α̃ = ``al`` = 0).
 
     ok is False if σ̄ = 0 somewhere (c at/after percolation: infinite resistance)."""
     n, wl, At = rule.n, rule.wl, rule.At
@@ -85,20 +121,23 @@ def _resid(tab, sc, rule, st, dxi, eb, dpi, pan, P):
         return W, math.inf, False
     fmax = 0.0
     for i in range(N):
-        F[i] = eb[i] - c[i] - dpi * Rt[i] / W
+        if al == 0.0:
+            F[i] = eb[i] - c[i] - dpi * Rt[i] / W
+        else:
+            F[i] = eb[i] - c[i] - _fluid(dpi * Rt[i] / W, al)
         if abs(F[i]) > fmax:
             fmax = abs(F[i])
     return W, fmax, True
 
 
 @njit(cache=True)
-def _newton(tab, sc, rule, wk, dpi, P, maxit, ftol):
+def _newton(tab, sc, rule, wk, dpi, al, P, maxit, ftol):
     """Damped Newton on the current mesh wk.pan from wk.s0; wk.s0.c and wk.s0.r hold the
-    result. Returns (W, its, ok)."""
+    result. Returns (W, its, ok). ``dpi`` is ψ_a, ``al`` α̃ (:func:`_resid`)."""
     n, wl, At = rule.n, rule.wl, rule.At
     pan, y1, y2, Y, K, dxi, eb = wk.pan, wk.y1, wk.y2, wk.Y, wk.K, wk.dxi, wk.eb
     N = P * n
-    W, fmax, ok = _resid(tab, sc, rule, wk.s0, dxi, eb, dpi, pan, P)
+    W, fmax, ok = _resid(tab, sc, rule, wk.s0, dxi, eb, dpi, al, pan, P)
     if not ok:
         return W, 0, False
     cur = 0          # 0: current state in wk.s0; 1: in wk.s1
@@ -119,11 +158,13 @@ def _newton(tab, sc, rule, wk, dpi, P, maxit, ftol):
         for p in range(P - 1, -1, -1):
             hh = 0.5 * (pan[p + 1] - pan[p])
             for i in range(n):
+                # Barus: row i's coupling times P'(ψ_i) = 1/(1 − α̃ ψ_i) (1 for α̃ = 0)
+                gi = g if al == 0.0 else g / (1.0 - al * g * RR[p * n + i])
                 for k in range(n):
-                    K[i, k] = -g * hh * At[i, k] * DD[p * n + k]
+                    K[i, k] = -gi * hh * At[i, k] * DD[p * n + k]
                 K[i, i] -= 1.0
-                Y[i, 0] = -FF[p * n + i] + g * S1
-                Y[i, 1] = g * RR[p * n + i] / W + g * S2
+                Y[i, 0] = -FF[p * n + i] + gi * S1
+                Y[i, 1] = gi * RR[p * n + i] / W + gi * S2
             if not solve_small(K, Y, n, 2):
                 return W, its, False
             for k in range(n):
@@ -147,7 +188,7 @@ def _newton(tab, sc, rule, wk, dpi, P, maxit, ftol):
         for ls in range(24):
             for i in range(N):
                 ct[i] = cc[i] + lam * y1[i]
-            Wt, ft, okt = _resid(tab, sc, rule, trial, dxi, eb, dpi, pan, P)
+            Wt, ft, okt = _resid(tab, sc, rule, trial, dxi, eb, dpi, al, pan, P)
             if okt and ft <= (1.0 - 1e-4 * lam) * fmax:
                 accepted = True
                 break
@@ -172,11 +213,13 @@ def _newton(tab, sc, rule, wk, dpi, P, maxit, ftol):
 @njit(cache=True)
 def _first_guess(zone, m, wk, N, cperc, init_P, init_s):
     """Initial contact pressure c (into wk.s0.c) at the N nodes: c = e_b − Δπ s with
-    s = init_s (continuation, init_P > 0) or the fluid pressure linear in ξ across the zone,
+    s = init_s (continuation, init_P > 0) or the fluid pressure linear in ξ across the zone
+    (Barus: s the remaining fraction of ψ, c = e_b − P(ψ_a s)),
     capped below percolation. Returns the Newton tolerance on F (1e-13 of the pressure scale)."""
-    kind, gp, xg, pg, pia, pib = zone
+    kind, gp, xg, pg, pia, pib = zone.kind, zone.gp, zone.xg, zone.pg, zone.pia, zone.pib
     xi, eb, c = wk.xi, wk.eb, wk.s0.c
     dpi = pia - pib
+    psia = psi_drop(dpi, zone.al)
     scale = dpi
     for i in range(N):
         scale = max(scale, abs(eb[i]))
@@ -187,7 +230,7 @@ def _first_guess(zone, m, wk, N, cperc, init_P, init_s):
             s = init_s[i]
         else:
             s = (g1 - xi[i]) / (g1 - g0) if g1 > g0 else 0.5
-        ci = eb[i] - dpi * s
+        ci = eb[i] - _fluid(psia * s, zone.al)
         if ci > 0.9 * cperc and init_P == 0:
             ci = 0.9 * cperc
         c[i] = ci
@@ -247,14 +290,15 @@ def solve_case(tab, sc, rule, tol, maxit, zone, out, init_P, init_pan, init_s, s
     Returns (W, status, panels, error_estimate, newton_iterations), W = ∫ dξ/σ̄ over the
     zone. ``out`` (:class:`Mesh`: pan PMAX+1, c and r PMAX·n) receives the final mesh and the
     nodal contact pressure and resistance density; s_out (optional) the remaining fraction of
-    the pressure drop (p_f − p_b)/Δp at the nodes. With init_P > 0 the first mesh is init_pan
-    and the initial guess c = (p0 − p_b) − Δp·init_s at its nodes (continuation); otherwise P0
-    uniform panels and a fluid pressure linear in x. s_out is filled if it is large enough
-    (pass an empty array to skip).
+    the pressure drop (p_f − p_b)/Δp at the nodes (Barus: of ψ, ψ/ψ_a). With init_P > 0 the
+    first mesh is init_pan and the initial guess c = (p0 − p_b) − Δp·init_s at its nodes
+    (continuation; Barus: − P(ψ_a init_s)); otherwise P0 uniform panels and a fluid pressure
+    linear in x. s_out is filled if it is large enough (pass an empty array to skip).
     """
     n, P0, PMAX = rule.n, rule.P0, rule.PMAX
     Lp = rule.Lp
-    dpi = zone.pia - zone.pib
+    al = zone.al
+    dpi = psi_drop(zone.pia - zone.pib, al)  # ψ_a: Δπ for a constant viscosity
     wk = _work(n, PMAX)
     pan, pan2, err, coef, after, Pk = wk.pan, wk.pan2, wk.err, wk.coef, wk.after, wk.Pk
     c, r, eb, y1 = wk.s0.c, wk.s0.r, wk.eb, wk.y1
@@ -271,7 +315,8 @@ def solve_case(tab, sc, rule, tol, maxit, zone, out, init_P, init_pan, init_s, s
     for rnd in range(4 * PMAX + 1):
         # intermediate meshes: converge loosely (the indicator needs r to ~1e-9 only); the
         # final mesh: polish to round-off (each round adds a panel: the bound is never reached)
-        W, its, conv = _newton(tab, sc, rule, wk, dpi, P, maxit, ftol if polish else 1e4 * ftol)
+        W, its, conv = _newton(tab, sc, rule, wk, dpi, al, P, maxit,
+                               ftol if polish else 1e4 * ftol)
         total_it += its
         if not conv:
             status = ST_NEWTON_FAILED
@@ -292,11 +337,11 @@ def solve_case(tab, sc, rule, tol, maxit, zone, out, init_P, init_pan, init_s, s
         P = Pn
         _fill_nodes(zone, rule, wk, P)
         for i in range(P * n):
-            c[i] = eb[i] - dpi * y1[i]
+            c[i] = eb[i] - _fluid(dpi * y1[i], al)
     _copy_mesh(P, n, pan, c, r, out.pan, out.c, out.r)
     if s_out.size >= P * n:
         for i in range(P * n):
-            s_out[i] = (eb[i] - c[i]) / dpi
+            s_out[i] = _remaining(eb[i] - c[i], dpi, al)
     return W, status, P, est, total_it
 
 
@@ -349,13 +394,14 @@ def _refine_previous(rule, r_prev, pan, P, W_prev, coef, after, Pk, new):
 
 
 @njit(cache=True)
-def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, out):
+def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, al, out):
     """solve_case, and if Newton fails from the plain initial guess (close to percolation,
     where ln σ̄ falls by ~10³ per unit ln p), continuation in p_a: start where the peak
     contact pressure max p0 − p_a is 0.6 p_perc (or halfway in p_a for the average theory),
     then step the distance to percolation δ = p_perc − (max p0 − p_a) geometrically down to
     its target, each step starting from the previous solution on the previous mesh.
-    ``out`` (:class:`Mesh`) receives the final mesh, c and r.
+    ``out`` (:class:`Mesh`) receives the final mesh, c and r; ``al`` α̃ of a Barus fluid (0:
+    constant viscosity).
     Returns (W, status, panels, error_estimate, newton_iterations, continuation_steps)."""
     n, PMAX = rule.n, rule.PMAX
     gp = np.empty(3)
@@ -363,7 +409,7 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, out):
         return 0.0, ST_NO_ZONE, 0, 0.0, 0, 0
     nil = np.empty(0)
     W, st, P, est, its = solve_case(tab, sc, rule, rule.tol, rule.maxit,
-                                    Zone(kind, gp, xg, pg, pia, pib), out, 0, nil, nil, nil)
+                                    Zone(kind, gp, xg, pg, pia, pib, al), out, 0, nil, nil, nil)
     if st != ST_NEWTON_FAILED:
         return W, st, P, est, its, 0
     cperc = sc.p_perc
@@ -377,7 +423,7 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, out):
     rr = np.empty(NMAX)
     zone_params(kind, base, xg, pg, pa0, pib, gp)
     W, st, P, est, it0 = solve_case(tab, sc, rule, 1e-2, rule.maxit,
-                                    Zone(kind, gp, xg, pg, pa0, pib), Mesh(pan, cc, rr), 0, pan,
+                                    Zone(kind, gp, xg, pg, pa0, pib, al), Mesh(pan, cc, rr), 0, pan,
                                     sn, sn)
     its += it0
     if st == ST_NEWTON_FAILED:
@@ -402,7 +448,7 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, out):
             pa = pia
         zone_params(kind, base, xg, pg, pa, pib, gp)
         W2, st2, P2, est2, it2 = solve_case(tab, sc, rule, rule.tol, min(rule.maxit, 25),
-                                            Zone(kind, gp, xg, pg, pa, pib),
+                                            Zone(kind, gp, xg, pg, pa, pib, al),
                                             Mesh(pan_new, cc, rr), P, pan, sn, s_new)
         its += it2
         if st2 == ST_NEWTON_FAILED:
@@ -430,8 +476,9 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, out):
 
 
 @njit(cache=True)
-def solve_row(tab, sc, rule, kind, xg, p0n, amp, pia, pib, mesh):
-    """One soft seal: (W, status, panels, error_estimate, x_s, x_e).
+def solve_row(tab, sc, rule, kind, xg, p0n, amp, pia, pib, al, mesh):
+    """One soft seal: (W, status, panels, error_estimate, x_s, x_e); ``al`` α̃ = α E* of a
+    Barus fluid (0: constant viscosity; W is then the resistance of ψ_a, q ∝ ψ_a/W).
 
     kind 0, Hertz: amp = π_H (p0n unused); kind 1, array: p0 = p0n·amp at ξ = xg (p0n [Pa],
     amp = 1/E*). Reduced π_a, π_b. W = ∫dξ/σ̄ over the sealing zone; ``mesh``
@@ -441,14 +488,14 @@ def solve_row(tab, sc, rule, kind, xg, p0n, amp, pia, pib, mesh):
         base1 = np.empty(1)
         base1[0] = amp
         W, st, P, est, its, cs = solve_robust(tab, sc, rule, 0, base1, xg, p0n, amp, pia, pib,
-                                              mesh)
+                                              al, mesh)
         xs = math.nan
         xe = math.nan
     else:
         pg = p0n * amp
         xs, xe = array_zone(xg, pg, pia, pib)
         W, st, P, est, its, cs = solve_robust(tab, sc, rule, 1, pg, xg, pg, pg.max(), pia, pib,
-                                              mesh)
+                                              al, mesh)
     return W, st, P, est, xs, xe
 
 
@@ -464,13 +511,14 @@ def _store_row(out, i, W, st, P, est, xs, xe):
 
 
 @njit(cache=True, parallel=True)
-def solve_rows(tab, sc, rule, kind, xg, p0n, amp, pia, pib, rows, out):
+def solve_rows(tab, sc, rule, kind, xg, p0n, amp, pia, pib, al, rows, out):
     """Soft seals of the rows listed in ``rows`` (parallel; see :func:`solve_row`) into
-    ``out`` (flat record of arrays W, status, panels, err, xs, xe)."""
+    ``out`` (flat record of arrays W, status, panels, err, xs, xe); ``al`` per row (α̃ of a
+    Barus fluid, 0: constant viscosity)."""
     for j in prange(rows.size):
         i = rows[j]
         mesh = Mesh(np.empty(rule.PMAX + 1), np.empty(rule.PMAX * rule.n),
                     np.empty(rule.PMAX * rule.n))
         W, st, P, est, xs, xe = solve_row(tab, sc, rule, kind, xg, p0n, amp[i], pia[i], pib[i],
-                                          mesh)
+                                          al[i], mesh)
         _store_row(out, i, W, st, P, est, xs, xe)

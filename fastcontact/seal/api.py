@@ -111,7 +111,7 @@ def _solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, equal):
         rule = panel_rule(o, tol=min(o["tol"], EQUALITY_TOL) if eq else None,
                           max_panels=max(o["max_panels"], 256) if eq else None)
         _panels.solve_rows(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pia, pib,
-                           np.ascontiguousarray(sel, dtype=np.int64), out)
+                           np.zeros(amp.size), np.ascontiguousarray(sel, dtype=np.int64), out)
     return out
 
 
