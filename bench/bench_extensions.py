@@ -594,7 +594,8 @@ def main():
         lines += ["", "Speeds are measured in the same run as their base engines (the machine "
                   "is shared: absolute times are noisy, ratios are the meaningful numbers). "
                   "The Barus squeeze-out and tire footprint run on tables (α p0 <= 0.6); the "
-                  "seal η(p) engines are per-case quadratures / shooting.",
+                  "seal η(p) engines solve per row: quadrature (flat rings), the base engine's panel "
+                  "collocation (Barus O-ring), shooting (Roelands O-ring).",
                   ""]
     lines += body
     out = HERE / ("extensions_results.md" if args.only == ap.get_default("only")
