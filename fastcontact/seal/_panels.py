@@ -36,15 +36,15 @@ from ._mesh import (array_zone, geometry, interp_series, panel_series, remaining
 from ._panel_records import Mesh, State, Work, Zone, _work
 from ._sigma import sig_d
 
-__all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "psi_drop", "ST_OK",
-           "ST_NOT_REFINED", "ST_NEWTON_FAILED", "ST_NO_ZONE", "Zone", "State", "Work", "Mesh"]
+__all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "ST_OK", "ST_NOT_REFINED",
+           "ST_NEWTON_FAILED", "ST_NO_ZONE", "Zone", "State", "Work", "Mesh"]
 
 #: status codes of solve_case
 ST_OK, ST_NOT_REFINED, ST_NEWTON_FAILED, ST_NO_ZONE = 0, 1, 2, 3
 
 
 @njit(cache=True, inline="always")
-def psi_drop(dpi, al):
+def _psi_drop(dpi, al):
     """ψ_a = (1 − e^{−α̃ Δπ})/α̃ of a reduced pressure drop Δπ (Δπ itself for α̃ = 0)."""
     if al == 0.0:
         return dpi
@@ -219,7 +219,7 @@ def _first_guess(zone, m, wk, N, cperc, init_P, init_s):
     kind, gp, xg, pg, pia, pib = zone.kind, zone.gp, zone.xg, zone.pg, zone.pia, zone.pib
     xi, eb, c = wk.xi, wk.eb, wk.s0.c
     dpi = pia - pib
-    psia = psi_drop(dpi, zone.al)
+    psia = _psi_drop(dpi, zone.al)
     scale = dpi
     for i in range(N):
         scale = max(scale, abs(eb[i]))
@@ -298,7 +298,7 @@ def solve_case(tab, sc, rule, tol, maxit, zone, out, init_P, init_pan, init_s, s
     n, P0, PMAX = rule.n, rule.P0, rule.PMAX
     Lp = rule.Lp
     al = zone.al
-    dpi = psi_drop(zone.pia - zone.pib, al)  # ψ_a: Δπ for a constant viscosity
+    dpi = _psi_drop(zone.pia - zone.pib, al)  # ψ_a: Δπ for a constant viscosity
     wk = _work(n, PMAX)
     pan, pan2, err, coef, after, Pk = wk.pan, wk.pan2, wk.err, wk.coef, wk.after, wk.Pk
     c, r, eb, y1 = wk.s0.c, wk.s0.r, wk.eb, wk.y1
@@ -423,8 +423,8 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, al, out):
     rr = np.empty(NMAX)
     zone_params(kind, base, xg, pg, pa0, pib, gp)
     W, st, P, est, it0 = solve_case(tab, sc, rule, 1e-2, rule.maxit,
-                                    Zone(kind, gp, xg, pg, pa0, pib, al), Mesh(pan, cc, rr), 0, pan,
-                                    sn, sn)
+                                    Zone(kind, gp, xg, pg, pa0, pib, al), Mesh(pan, cc, rr), 0,
+                                    pan, sn, sn)
     its += it0
     if st == ST_NEWTON_FAILED:
         return W, st, P, est, its, 0
