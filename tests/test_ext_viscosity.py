@@ -251,6 +251,27 @@ def test_seal_hertz_lift_off_equality_and_shooting(tables):
     assert abs(got.Q[2] / sh.Q[0] - 1) < 1e-6
 
 
+def test_seal_hertz_panel_failure_falls_back_to_shooting(tables):
+    """Where the panel Newton fails (α p_H ~ 9 next to lift-off, EMT) the row is solved by the
+    200-step shooting instead (the same number as steps=200); at the lift-off equality,
+    where the shooting does not converge either, Q is NaN and the status says
+    "not_converged" (not "lift_off", whose Q is a finite limit)."""
+    from fastcontact.seal.viscosity import _barus_hertz_k
+    R, f_N = 1e-3, 3.0
+    a = math.sqrt(4 * f_N * R / (math.pi * E_STAR))
+    pH = 2 * f_N / (math.pi * a)
+    al = 9.0 / pH
+    _, ok = _barus_hertz_k(tables, "emt", *(np.array([v]) for v in
+                                            (E_STAR, pH, a, pH * (1 - 1e-3), 0.0, al)))
+    assert not ok[0]                                      # the panel solve fails here
+    kw = dict(profile="hertz", R=R, f_N=f_N, L_y=L_Y, E_star=E_STAR, eta=ETA, alpha_pv=al,
+              theory="emt")
+    got = seal_leak_piezo(tables, dp=[pH * (1 - 1e-3), pH], **kw)
+    sh = seal_leak_piezo(tables, dp=pH * (1 - 1e-3), steps=200, **kw)
+    assert got.status[0] == "ok" and got.Q[0] == sh.Q[0] and math.isfinite(got.Q[0])
+    assert got.status[1] == "not_converged" and math.isnan(got.Q[1]) and bool(got.lift_off[1])
+
+
 def test_seal_flags(tables):
     df = seal_leak_piezo(tables, p0=5e4, dp=[0.0, 6e4], L=5e-3, L_y=L_Y, E_star=E_STAR,
                          eta=ETA, alpha_pv=1e-5)

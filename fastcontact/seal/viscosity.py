@@ -59,8 +59,9 @@ __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
 HERTZ_STEPS = 200
 #: panel tolerance of the Barus O-ring's collocation solve (the base seal engine's solver in
 #: ψ; relative Legendre tail of the resistance density per panel), and at the lift-off
-#: equality p_a = p_H
-BARUS_PANEL_TOL = 1e-6
+#: equality p_a = p_H. Q is then within ~1e-7 of the converged solution, ~6e-6 within
+#: 1e-7 p_H of lift-off, where Q has a square-root limit (bench/extensions_results.md)
+BARUS_PANEL_TOL = 1e-7
 BARUS_EQUALITY_TOL = 1e-9
 
 
@@ -116,8 +117,9 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         Gauss–Legendre order and panel width in ln p_cont (uniform ring).
     steps : int or None
         RK4 steps of the O-ring shooting across the Hertz sealing zone. None (default): the
-        Barus O-ring by the base engine's panel collocation in ψ (~30× faster; error against
-        an adaptive DOP853 shooting in bench/extensions_results.md), the Roelands O-ring by
+        Barus O-ring by the base engine's panel collocation in ψ (~4× faster than 200 steps;
+        error against an adaptive DOP853 shooting in bench/extensions_results.md; rows where
+        its Newton fails fall back to the shooting), the Roelands O-ring by
         shooting with HERTZ_STEPS steps; an integer: shooting with that many steps (both
         laws).
     viscosity : {"barus", "roelands"}
@@ -156,8 +158,9 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         scale = (v["alpha_cj"] / float(tables.options.get("alpha_cj", 1.0))) ** 3
     Q = scale * v["L_y"] * kq * float(tables.h_rms) ** 3 / (12.0 * v["eta"])
     Q = np.where(lift, math.inf, np.where(conv & ~out_t, Q, math.nan))
-    status = np.select([lift, v["pa"] == pmax, perc, out_t, ~conv],
-                       ["open", "lift_off", "percolated", "above_table", "not_converged"], "ok")
+    # a NaN row says why before the lift-off equality's flag (its Q is finite when solved)
+    status = np.select([lift, out_t, perc, ~conv, v["pa"] == pmax],
+                       ["open", "above_table", "percolated", "not_converged", "lift_off"], "ok")
     cols.update({"p_a": v["pa"], "Q": Q, "lift_off": lift | (v["pa"] == pmax),
                  "percolated": perc, "converged": conv, "out_of_table": out_t, "status": status})
     return _piezo_frame(cols, law, theory, profile, shape, roelands_eta_inf)
@@ -259,8 +262,16 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
             _hertz_kernel_r(tab, sc, HertzRows(*sub), law[2],
                             HERTZ_STEPS if steps is None else int(steps), k, ok)
         elif steps is None:
-            k, ok = _barus_hertz_k(tables, theory, *(np.ascontiguousarray(x[run]) for x in
-                                                     (E, pH, a, pa, pb, v["alpha_pv"])))
+            sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, v["alpha_pv"])]
+            k, ok = _barus_hertz_k(tables, theory, *sub)
+            if not np.all(ok):   # Newton failed (α p_H >~ 6 next to lift-off): shooting
+                bad = np.flatnonzero(~ok)
+                kb = np.empty(bad.size)
+                okb = np.empty(bad.size, dtype=np.bool_)
+                _hertz_kernel(tab, sc, *(np.ascontiguousarray(x[bad]) for x in sub),
+                              HERTZ_STEPS, kb, okb)
+                k[bad] = kb
+                ok[bad] = okb
         else:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, v["alpha_pv"])]
             _hertz_kernel(tab, sc, *sub, int(steps), k, ok)
