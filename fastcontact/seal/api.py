@@ -25,7 +25,7 @@ from .._core.vocab import DEFAULT_THEORY
 from . import _panels
 from ._inputs import (alpha_scale, check_tables, check_theory_for, common_inputs, forbid,
                       hertz_contact, profile_kind, require)
-from .context import RowsOut, panel_rule, seal_context, solver_options
+from .context import NEAR_LIFT_OFF, RowsOut, panel_rule, seal_context, solver_options
 from ._uniform import leak_uniform
 from .hertz import VERIFY_TOL, table_W
 from .viscosity import seal_leak_piezo  # issue 14: Barus fluid (alpha_pv)
@@ -50,8 +50,8 @@ REFERENCES = (
     "with experiment, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019",
 )
 
-#: panel tolerance at the exact lift-off point p_a = max p0 (degenerate inlet end, where the
-#: Legendre-tail indicator under-estimates the error)
+#: panel tolerance at the exact lift-off point p_a = max p0 and within NEAR_LIFT_OFF below it
+#: (degenerate inlet end, where the Legendre-tail indicator under-estimates the error)
 EQUALITY_TOL = 1e-9
 
 _BASE = ("Q", "lift_off", "percolated", "status")
@@ -103,7 +103,8 @@ def _leak_uniform(sc, theory, p0, L, com, alpha_cj):
 
 # =========================================================================== profiles
 def _solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, equal):
-    """Run the soft-seal solver on rows ``idx`` (``equal``: rows at the lift-off equality)."""
+    """Run the soft-seal solver on rows ``idx`` (``equal``: rows at the lift-off equality or
+    within NEAR_LIFT_OFF below it, solved at EQUALITY_TOL)."""
     out = RowsOut.empty(amp.size)
     for sel, eq in ((idx[~equal], False), (idx[equal], True)):
         if not sel.size:
@@ -153,7 +154,8 @@ def _leak_hertz(sc, theory, R, f_N, com, alpha_cj, o):
         Wt = table_W(sc, piH, pia, idx[(p_b[idx] == 0.0) & (p_a[idx] != pH[idx])])
         idx = idx[~np.isfinite(Wt[idx])]
     out = _solve_profile_rows(sc, o, 0, np.zeros(2), np.zeros(2), piH, pia,
-                              np.ascontiguousarray(p_b / E), idx, p_a[idx] == pH[idx])
+                              np.ascontiguousarray(p_b / E), idx,
+                              p_a[idx] >= (1.0 - NEAR_LIFT_OFF) * pH[idx])
     if Wt is not None:
         fast = np.isfinite(Wt)
         out.W[fast] = Wt[fast]
@@ -196,7 +198,8 @@ def _leak_array(sc, theory, p0x, x, com, alpha_cj, o):
     idx = np.flatnonzero(solve)
     out = _solve_profile_rows(sc, o, 1, xi, np.ascontiguousarray(p0x, dtype=np.float64),
                               np.ascontiguousarray(1.0 / E), np.ascontiguousarray(p_a / E),
-                              np.ascontiguousarray(p_b / E), idx, p_a[idx] == pmax)
+                              np.ascontiguousarray(p_b / E), idx,
+                              p_a[idx] >= (1.0 - NEAR_LIFT_OFF) * pmax)
     xs = np.where(solve, out.xs, np.where(contact, 0.0, 1.0))
     xe = np.where(solve, out.xe, 1.0)
     cols = {"lift_off": p_a >= pmax, "percolated": perc, "p_max": np.full(E.size, pmax),
@@ -246,7 +249,9 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
     a_perc : float, optional
         If given it must equal the tables' percolation area fraction [-].
     solver : dict, optional
-        Knobs of the non-uniform solver (``fastcontact.seal.SOLVER_DEFAULTS``).
+        Knobs of the non-uniform solver (``fastcontact.seal.SOLVER_DEFAULTS``). Rows at or
+        within ``NEAR_LIFT_OFF`` (1e-4 relative) below lift-off are solved at the panel
+        tolerance EQUALITY_TOL (1e-9) whatever ``tol`` is (Q has a square-root limit there).
     alpha_pv : float or array_like, default 0.0
         Barus coefficient α [1/Pa], η = η0 exp(α(p_f − p_b)); 0 leaves the result unchanged.
     viscosity : {"barus", "roelands"}, default "barus"
