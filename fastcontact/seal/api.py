@@ -25,7 +25,8 @@ from .._core.vocab import DEFAULT_THEORY
 from . import _panels
 from ._inputs import (alpha_scale, check_tables, check_theory_for, common_inputs, forbid,
                       hertz_contact, profile_kind, require)
-from .context import NEAR_LIFT_OFF, RowsOut, panel_rule, seal_context, solver_options
+from .context import (EQUALITY_TOL, NEAR_LIFT_OFF, seal_context, solve_profile_rows,
+                      solver_options)
 from ._uniform import leak_uniform
 from .hertz import VERIFY_TOL, table_W
 from .viscosity import seal_leak_piezo  # issue 14: Barus fluid (alpha_pv)
@@ -50,9 +51,6 @@ REFERENCES = (
     "with experiment, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019",
 )
 
-#: panel tolerance at the exact lift-off point p_a = max p0 and within NEAR_LIFT_OFF below it
-#: (degenerate inlet end, where the Legendre-tail indicator under-estimates the error)
-EQUALITY_TOL = 1e-9
 
 _BASE = ("Q", "lift_off", "percolated", "status")
 _COLUMNS = {
@@ -102,18 +100,6 @@ def _leak_uniform(sc, theory, p0, L, com, alpha_cj):
 
 
 # =========================================================================== profiles
-def _solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, equal):
-    """Run the soft-seal solver on rows ``idx`` (``equal``: rows at the lift-off equality or
-    within NEAR_LIFT_OFF below it, solved at EQUALITY_TOL)."""
-    out = RowsOut.empty(amp.size)
-    for sel, eq in ((idx[~equal], False), (idx[equal], True)):
-        if not sel.size:
-            continue
-        rule = panel_rule(o, tol=min(o["tol"], EQUALITY_TOL) if eq else None,
-                          max_panels=max(o["max_panels"], 256) if eq else None)
-        _panels.solve_rows(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pia, pib,
-                           np.zeros(amp.size), np.ascontiguousarray(sel, dtype=np.int64), out)
-    return out
 
 
 def _finish_profile(sc, theory, cols, solve, contact, out, E, ell, dp, L_y, eta, alpha):
@@ -153,7 +139,7 @@ def _leak_hertz(sc, theory, R, f_N, com, alpha_cj, o):
     if o["table"]:
         Wt = table_W(sc, piH, pia, idx[(p_b[idx] == 0.0) & (p_a[idx] != pH[idx])])
         idx = idx[~np.isfinite(Wt[idx])]
-    out = _solve_profile_rows(sc, o, 0, np.zeros(2), np.zeros(2), piH, pia,
+    out = solve_profile_rows(sc, o, 0, np.zeros(2), np.zeros(2), piH, pia,
                               np.ascontiguousarray(p_b / E), idx,
                               p_a[idx] >= (1.0 - NEAR_LIFT_OFF) * pH[idx])
     if Wt is not None:
@@ -196,7 +182,7 @@ def _leak_array(sc, theory, p0x, x, com, alpha_cj, o):
     above = contact & ~perc & ((pmax - p_b) / E > sc.p_top * (1 + 1e-13))
     solve = contact & ~perc & ~above & (dp > 0)
     idx = np.flatnonzero(solve)
-    out = _solve_profile_rows(sc, o, 1, xi, np.ascontiguousarray(p0x, dtype=np.float64),
+    out = solve_profile_rows(sc, o, 1, xi, np.ascontiguousarray(p0x, dtype=np.float64),
                               np.ascontiguousarray(1.0 / E), np.ascontiguousarray(p_a / E),
                               np.ascontiguousarray(p_b / E), idx,
                               p_a[idx] >= (1.0 - NEAR_LIFT_OFF) * pmax)

@@ -16,11 +16,11 @@ from .._core.cache import PerObjectCache
 from ..flow.conductivity import check_theory
 from ..kernels.quadrature import gauss_legendre
 from ..tables.build import SIGMA_FLOOR
-from . import _sigma
+from . import _panels, _sigma
 
 __all__ = ["SealRecord", "SealContext", "seal_context", "PanelRule", "RowsOut", "panel_rule",
            "solver_options", "SOLVER_DEFAULTS", "RETAB_H", "RETAB_TOL", "PRIM_H", "PRIM_GL",
-           "PRIM_DEPTH", "TAIL_SPLIT", "NEAR_LIFT_OFF"]
+           "PRIM_DEPTH", "TAIL_SPLIT", "NEAR_LIFT_OFF", "EQUALITY_TOL", "solve_profile_rows"]
 
 #: re-tabulation of ln σ̄ (uniform in ln π): spacing and per-cell verification tolerance
 RETAB_H = 1.0 / 64.0
@@ -257,16 +257,19 @@ def seal_context(tables, theory) -> SealContext:
 
 
 # =========================================================================== soft-seal solver
-#: soft-seal solver knobs (non-uniform profiles): Gauss–Legendre nodes per panel, initial
-#: panels, grading order of the end map, panel error tolerance (Legendre tail of the
-#: resistance density relative to the total), maximum panels, Newton iterations per mesh;
-#: ``table``: O-rings with p_b = 0 from the verified table of W (:mod:`.hertz`).
 #: rows with p_a within this fraction of max p0 below lift-off are solved at the lift-off
 #: equality's tight panel tolerance: Q has a square-root limit there and the panel indicator
 #: under-estimates the error of the inlet end (at the default tolerance 1e-3 an O-ring with
 #: p_b > 0 was off by 2.3e-6 at p_a = p_H (1 - 1e-7), 7e-7 at 1e-5, 3e-8 at 1e-3 against the
 #: independent collocation reference of the tests; 1.5e-9 at the tight tolerance)
 NEAR_LIFT_OFF = 1e-4
+#: panel tolerance at the exact lift-off point p_a = max p0 and within NEAR_LIFT_OFF below it
+#: (degenerate inlet end, where the Legendre-tail indicator under-estimates the error)
+EQUALITY_TOL = 1e-9
+#: soft-seal solver knobs (non-uniform profiles): Gauss–Legendre nodes per panel, initial
+#: panels, grading order of the end map, panel error tolerance (Legendre tail of the
+#: resistance density relative to the total), maximum panels, Newton iterations per mesh;
+#: ``table``: O-rings with p_b = 0 from the verified table of W (:mod:`.hertz`).
 SOLVER_DEFAULTS = dict(nodes=10, panels=4, grading=2, tol=1e-3, max_panels=128, max_newton=60,
                        table=True)
 
@@ -371,3 +374,21 @@ def panel_rule(o, tol=None, max_panels=None):
     return PanelRule(int(o["grading"]), n, int(o["panels"]),
                      int(o["max_panels"] if max_panels is None else max_panels),
                      float(o["tol"] if tol is None else tol), int(o["max_newton"]), z, w, At, Lp)
+
+
+def solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, near, al=None):
+    """The soft-seal solver (:func:`._panels.solve_rows`) on rows ``idx`` into a fresh
+    :class:`RowsOut`: rows with ``near`` (at or within NEAR_LIFT_OFF below lift-off) at the
+    panel tolerance min(tol, EQUALITY_TOL) and at least 256 panels, the others with the
+    options ``o`` as they are; ``al`` the rows' reduced Barus α̃ = α E* (None: 0, a constant
+    viscosity)."""
+    out = RowsOut.empty(amp.size)
+    al = np.zeros(amp.size) if al is None else np.ascontiguousarray(al, dtype=np.float64)
+    for sel, nr in ((idx[~near], False), (idx[near], True)):
+        if not sel.size:
+            continue
+        rule = panel_rule(o, tol=min(o["tol"], EQUALITY_TOL) if nr else None,
+                          max_panels=max(o["max_panels"], 256) if nr else None)
+        _panels.solve_rows(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pia, pib, al,
+                           np.ascontiguousarray(sel, dtype=np.int64), out)
+    return out

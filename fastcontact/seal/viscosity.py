@@ -47,7 +47,7 @@ from ..flow.piezoviscosity import ROELANDS_ETA_INF, check_law, roelands_paramete
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from . import _panels
-from .context import NEAR_LIFT_OFF, RowsOut, panel_rule, seal_context, solver_options
+from .context import NEAR_LIFT_OFF, seal_context, solve_profile_rows, solver_options
 from ._piezo_kernels import (TAIL_CUT, HertzRows, Quad, UniformRows, _hertz_kernel,
                              _hertz_kernel_r, _uniform_kernel)
 
@@ -58,11 +58,11 @@ __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
 #: O-ring's shooting when ``steps`` is given
 HERTZ_STEPS = 200
 #: panel tolerance of the Barus O-ring's collocation solve (the base seal engine's solver in
-#: ψ; relative Legendre tail of the resistance density per panel), and at or within
+#: ψ; relative Legendre tail of the resistance density per panel); at or within
 #: NEAR_LIFT_OFF below the lift-off equality p_a = p_H, where Q has a square-root limit and
-#: converges slowly in the tolerance (bench/extensions_results.md)
+#: converges slowly in the tolerance, the base engine's EQUALITY_TOL
+#: (bench/extensions_results.md)
 BARUS_PANEL_TOL = 1e-7
-BARUS_EQUALITY_TOL = 1e-9
 
 
 # =========================================================================== API
@@ -291,16 +291,10 @@ def _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha):
     """(k = 12 η0 q/h³ [Pa/m], converged) of Barus O-rings (p_a <= p_H, Δp > 0) by the base
     seal engine's panel collocation in ψ (:mod:`._panels`, α̃ = α E*): k = ψ_a/(a W) with
     ψ_a = (1 - e^{-αΔp})/α [Pa] and W the reduced resistance of the sealing zone."""
-    sc = seal_context(tables, theory)
-    o = solver_options(None)
-    out = RowsOut.empty(E.size)
-    near = pa >= (1.0 - NEAR_LIFT_OFF) * pH   # at or next to lift-off: the tight tolerance
-    for sel, tol in ((~near, BARUS_PANEL_TOL), (near, BARUS_EQUALITY_TOL)):
-        idx = np.flatnonzero(sel)
-        if idx.size:
-            _panels.solve_rows(sc.tab, sc.rec, panel_rule(o, tol=tol, max_panels=256), 0,
-                               np.zeros(2), np.zeros(2), pH / E, pa / E, pb / E, alpha * E,
-                               idx.astype(np.int64), out)
+    o = solver_options({"tol": BARUS_PANEL_TOL, "max_panels": 256})
+    out = solve_profile_rows(seal_context(tables, theory), o, 0, np.zeros(2), np.zeros(2),
+                             pH / E, pa / E, pb / E, np.arange(E.size),
+                             pa >= (1.0 - NEAR_LIFT_OFF) * pH, alpha * E)
     dp = pa - pb
     with np.errstate(divide="ignore", invalid="ignore"):
         psia = np.where(alpha > 0.0, -np.expm1(-alpha * dp) / np.where(alpha > 0.0, alpha, 1.0),
