@@ -20,7 +20,9 @@ from ._primitive_eval import Primitive, _index_map
 __all__ = ["load_or_build", "write", "read", "set_primitive_cache", "primitive_path",
            "PRIMITIVE_VERSION"]
 
-PRIMITIVE_VERSION = 2
+#: format and model version of the stored primitives (files of another version are rebuilt);
+#: 3: the tail's decay length u0 from the table's exact slope at its top (2026-11-26)
+PRIMITIVE_VERSION = 3
 _CACHE_ATTR = "_squeeze_primitive_dir"
 
 
