@@ -63,6 +63,16 @@ HERTZ_STEPS = 200
 #: converges slowly in the tolerance, the base engine's EQUALITY_TOL
 #: (bench/extensions_results.md)
 BARUS_PANEL_TOL = 1e-7
+#: the default shooting of O-rings (Roelands; Barus rows whose panel Newton fails, α p_H >~ 5
+#: next to lift-off) is checked (:func:`_checked_shooting`): (HERTZ_STEPS/2, HERTZ_STEPS) steps,
+#: then rows whose two results differ by more than FALLBACK_RTOL (relative) with
+#: (FALLBACK_STEPS/2, FALLBACK_STEPS), then "not_converged" (Q = NaN). Next to lift-off 200
+#: steps were off by up to 3e-5 (Barus, against the DOP853 reference; Roelands, against 3200
+#: steps) and 3200 by <= 5e-8 (bench/extensions_results.md); Barus rows start at the second
+#: level (the panel rows that fail are all next to lift-off)
+FALLBACK_STEPS = 3200
+FALLBACK_RTOL = 1e-6
+CHECKED_LEVELS = ((HERTZ_STEPS // 2, HERTZ_STEPS), (FALLBACK_STEPS // 2, FALLBACK_STEPS))
 
 
 # =========================================================================== API
@@ -119,9 +129,11 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         RK4 steps of the O-ring shooting across the Hertz sealing zone. None (default): the
         Barus O-ring by the base engine's panel collocation in ψ (~4× faster than 200 steps;
         error against an adaptive DOP853 shooting in bench/extensions_results.md; rows where
-        its Newton fails fall back to the shooting), the Roelands O-ring by
-        shooting with HERTZ_STEPS steps; an integer: shooting with that many steps (both
-        laws).
+        its Newton fails are shot with FALLBACK_STEPS steps, checked against half as many:
+        "not_converged" (Q = NaN) where the two differ by more than FALLBACK_RTOL), the
+        Roelands O-ring by shooting with HERTZ_STEPS steps checked against half as many (rows
+        where they differ by more than FALLBACK_RTOL again with FALLBACK_STEPS, then
+        "not_converged"); an integer: shooting with that many steps, unchecked (both laws).
     viscosity : {"barus", "roelands"}
         Viscosity law (module docstring; :mod:`fastcontact.flow.piezoviscosity`). Roelands:
         ln(η/η0) = ln(η0/η_∞)[(1 + (p_f - p_b)/p_r)^Z - 1], solved without the reduced
@@ -259,19 +271,19 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
         ok = np.empty(int(run.sum()), dtype=np.bool_)
         if law is not None:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, law[0], law[1])]
-            _hertz_kernel_r(tab, sc, HertzRows(*sub), law[2],
-                            HERTZ_STEPS if steps is None else int(steps), k, ok)
+            if steps is None:
+                k, ok = _checked_shooting(_shooter(_hertz_kernel_r, tab, sc, HertzRows(*sub),
+                                                   law[2]), k.size, CHECKED_LEVELS)
+            else:
+                _hertz_kernel_r(tab, sc, HertzRows(*sub), law[2], int(steps), k, ok)
         elif steps is None:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, v["alpha_pv"])]
             k, ok = _barus_hertz_k(tables, theory, *sub)
-            if not np.all(ok):   # Newton failed (α p_H >~ 6 next to lift-off): shooting
+            if not np.all(ok):   # Newton failed (α p_H >~ 5 next to lift-off): shooting
                 bad = np.flatnonzero(~ok)
-                kb = np.empty(bad.size)
-                okb = np.empty(bad.size, dtype=np.bool_)
-                _hertz_kernel(tab, sc, *(np.ascontiguousarray(x[bad]) for x in sub),
-                              HERTZ_STEPS, kb, okb)
-                k[bad] = kb
-                ok[bad] = okb
+                k[bad], ok[bad] = _checked_shooting(
+                    _shooter(_hertz_kernel, tab, sc, tuple(x[bad] for x in sub)), bad.size,
+                    CHECKED_LEVELS[1:])
         else:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, v["alpha_pv"])]
             _hertz_kernel(tab, sc, *sub, int(steps), k, ok)
@@ -285,6 +297,41 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
         cols["open_inlet"] = np.where(~lift, a * (1.0 - np.sqrt(1.0 - sa * sa)), 2 * a)
         cols["open_outlet"] = np.where(~lift, a * (1.0 - np.sqrt(1.0 - sb * sb)), 0.0)
     return cols, (kq, conv, lift, perc, out_t, pH)
+
+
+def _checked_shooting(shoot, m, levels):
+    """(k, converged) of m O-rings by a shooting ``shoot(n, idx)`` -> (k, ok) of rows idx with n
+    steps, checked: at each level (n1, n2) of ``levels`` the rows still open are shot with n1
+    and n2 steps and keep k(n2) where the two agree within FALLBACK_RTOL (relative; the
+    difference bounds the error of k(n2) for any order >= 1 of the RK4 next to the zone ends);
+    the others go to the next level, and are not converged after the last."""
+    k = np.full(m, np.nan)
+    ok = np.zeros(m, dtype=bool)
+    todo = np.arange(m)
+    for n1, n2 in levels:
+        k1, ok1 = shoot(n1, todo)
+        k2, ok2 = shoot(n2, todo)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            agree = ok1 & ok2 & (np.abs(k1 / k2 - 1.0) <= FALLBACK_RTOL)
+        k[todo] = k2
+        ok[todo] = agree
+        todo = todo[~agree]
+        if not todo.size:
+            break
+    return k, ok
+
+
+def _shooter(kernel, tab, sc, rows, *extra):
+    """``shoot(n, idx)`` of :func:`_checked_shooting` for a prange shooting kernel called as
+    kernel(tab, sc, *rows[idx], *extra, n, k, ok) (``rows`` a tuple of arrays, or a HertzRows)."""
+    def shoot(n, idx):
+        k = np.empty(idx.size)
+        ok = np.empty(idx.size, dtype=np.bool_)
+        sub = [np.ascontiguousarray(x[idx], dtype=np.float64) for x in rows]
+        args = (HertzRows(*sub),) if isinstance(rows, HertzRows) else tuple(sub)
+        kernel(tab, sc, *args, *extra, int(n), k, ok)
+        return k, ok
+    return shoot
 
 
 def _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha):
