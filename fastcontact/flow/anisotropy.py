@@ -269,17 +269,45 @@ DIRECTIONAL_STEMS = ("sigma_emt", "dlnsigma_emt", "d2lnsigma_emt", "phi_emt", "p
 DIRECTIONS = ("x", "y")
 
 
+#: nodes of the local polynomials that give the directional columns' derivatives on the
+#: tables' nodes (degree 8, as the tables' own σ̄), used at table nodes whose two intervals
+#: are at most DIR_POLY_MAX_H wide in ln p̄ (the default grid of 4 points per decade: 0.576),
+#: else the spline's derivatives. Measured at random pressures (γ_T = 3): default tables
+#: 2.4e-6 with the spline's derivatives, 3e-8 with the polynomials'; an unrefined grid of
+#: 2 per decade (intervals 1.15) 1.9e-5 with the spline's, 1.4e-4 with the polynomials'
+#: (there the quintic Hermite weighs a second-derivative error by h²)
+DIR_STENCIL = 9
+DIR_POLY_MAX_H = 0.6
+
+
 def _columns_on_nodes(tables, d, direction):
-    """The "emt" columns in ``direction`` on the tables' own p̄ nodes, from the spline of the
-    :class:`DirectionalTable` ``d`` (σ̄, its first two ln-derivatives, φ_p, percolated)."""
+    """The "emt" columns in ``direction`` on the tables' own p̄ nodes, from the
+    :class:`DirectionalTable` ``d`` (σ̄, its first two ln-derivatives, φ_p, percolated).
+
+    The tables' nodes are knots of ``d`` (exact values there); the derivatives come from the
+    local polynomials through the knots (:data:`DIR_STENCIL`, as the tables do for their own
+    σ̄) at nodes whose intervals are at most DIR_POLY_MAX_H wide, else from the spline (whose
+    derivatives left the quintic Hermite on tables of 4 points per decade off by 2.4e-6 at
+    random pressures; now 3e-8, bench/extensions_results.md)."""
+    from ..tables.build import _node_derivative
     lnp = np.log(np.asarray(tables.data["p_over_E"], dtype=np.float64))
     spl, n_open = d._spl[direction]
     last = d.lnp[n_open - 1]
     sig = d.sigma_bar(np.exp(lnp), 1.0, direction)
     inside = (lnp <= last) & (sig > 0)
+    d1, d2 = spl(lnp, 1), spl(lnp, 2)
+    ls = d.lnsig[direction]
+    open_ = np.isfinite(ls)
+    k1, k2 = _node_derivative(d.lnp, np.where(open_, ls, 0.0), open_, DIR_STENCIL)
+    h = np.diff(lnp)                       # the wider of each node's two intervals
+    fine = np.maximum(np.append(h, 0.0), np.append(0.0, h)) <= DIR_POLY_MAX_H
+    j = np.clip(np.searchsorted(d.lnp, lnp), 0, d.lnp.size - 1)
+    use = (d.lnp[j] == lnp) & open_[j] & fine
+    d1 = np.where(use, k1[j], d1)
+    d2 = np.where(use, k2[j], d2)
     return {"sigma_emt": np.ascontiguousarray(sig),
-            "dlnsigma_emt": np.ascontiguousarray(np.where(inside, spl(lnp, 1), 0.0)),
-            "d2lnsigma_emt": np.ascontiguousarray(np.where(inside, spl(lnp, 2), 0.0)),
+            "dlnsigma_emt": np.ascontiguousarray(np.where(inside, d1, 0.0)),
+            "d2lnsigma_emt": np.ascontiguousarray(np.where(inside, d2, 0.0)),
             "phi_emt": np.ascontiguousarray(sig / np.asarray(tables.data["u_over_h"]) ** 3),
             "percolated_emt": lnp >= d.lnp_perc[direction]}
 
