@@ -39,6 +39,7 @@ sys.path.insert(0, str(HERE))
 import fastcontact as fc  # noqa: E402
 import fastcontact.seal.hertz  # noqa: E402,F401
 from machine_info import cpu_model  # noqa: E402
+from results_notes import write_keeping_notes  # noqa: E402
 from reference.seal_reference import (  # noqa: E402
     SigmaInterp, hertz_reference, uniform_reference)
 
@@ -223,7 +224,7 @@ def main():
         f"whose direct reference is already percolated (not counted): {u['zero']}.",
         "",
     ]
-    (HERE / "seal_results.md").write_text("\n".join(md))
+    write_keeping_notes(HERE / "seal_results.md", "\n".join(md))
     print("\n".join(md))
 
 

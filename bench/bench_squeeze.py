@@ -42,6 +42,7 @@ from fastcontact.tables import Tables  # noqa: E402
 from fastcontact.tables.defaults import default_table_path  # noqa: E402
 from fastcontact.tire import tire_footprint  # noqa: E402
 from machine_info import cpu_model  # noqa: E402
+from results_notes import write_keeping_notes  # noqa: E402
 from reference.squeeze_reference import SqueezeReference, tau0  # noqa: E402
 
 SURFACE = "asphalt_024mm"
@@ -228,7 +229,7 @@ def write(rows, t_ref, load0, load1, n_fast, n_quad):
         err = info.get("max_rel_err_T", float("nan"))
         L.append(f"| {th} | {1e3 * s:.0f} | {info['nx']} × {info['nz']} | {err:.1e} |")
     L.append("")
-    (HERE / "squeeze_results.md").write_text("\n".join(L) + "\n")
+    write_keeping_notes(HERE / "squeeze_results.md", "\n".join(L) + "\n")
     print("\n".join(L))
 
 
