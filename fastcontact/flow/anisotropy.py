@@ -41,6 +41,7 @@ from scipy.interpolate import CubicSpline
 
 from .._core.cache import PerObjectCache
 from .._core.validate import check_positive
+from ..tables.node_derivatives import local_derivatives
 from ..contact import area_fraction, percolation_pressure
 from ._kernels import EMT_TOL
 from .conductivity import check_emt_threshold, conductivity
@@ -289,7 +290,6 @@ def _columns_on_nodes(tables, d, direction):
     σ̄) at nodes whose intervals are at most DIR_POLY_MAX_H wide, else from the spline (whose
     derivatives left the quintic Hermite on tables of 4 points per decade off by 2.4e-6 at
     random pressures; now 3e-8, bench/extensions_results.md)."""
-    from ..tables.build import _node_derivative
     lnp = np.log(np.asarray(tables.data["p_over_E"], dtype=np.float64))
     spl, n_open = d._spl[direction]
     last = d.lnp[n_open - 1]
@@ -298,7 +298,7 @@ def _columns_on_nodes(tables, d, direction):
     d1, d2 = spl(lnp, 1), spl(lnp, 2)
     ls = d.lnsig[direction]
     open_ = np.isfinite(ls)
-    k1, k2 = _node_derivative(d.lnp, np.where(open_, ls, 0.0), open_, DIR_STENCIL)
+    k1, k2 = local_derivatives(d.lnp, np.where(open_, ls, 0.0), open_, DIR_STENCIL)
     h = np.diff(lnp)                       # the wider of each node's two intervals
     fine = np.maximum(np.append(h, 0.0), np.append(0.0, h)) <= DIR_POLY_MAX_H
     j = np.clip(np.searchsorted(d.lnp, lnp), 0, d.lnp.size - 1)

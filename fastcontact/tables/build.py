@@ -21,6 +21,7 @@ from ..flow.conductivity import (EMT_TOL, check_anisotropy, check_emt_threshold,
 from ..kernels.hermite import quintic_np
 from ..kernels.locate import Grid
 from ..surface.psd import PSD
+from .node_derivatives import local_derivatives
 from .store import Tables
 
 __all__ = ["precompute", "default_grid", "TOLERANCE", "DEFAULT_POINTS_PER_DECADE", "SIGMA_FLOOR"]
@@ -47,7 +48,7 @@ BOUNDARY_FACTOR = 1e3
 MAX_NODES = 6000
 MIN_DLNP = 1e-6
 #: the theories whose ln σ̄ derivatives at the nodes come from local polynomials through the
-#: nodes (:func:`_node_derivative`) — no closed form; the average theory's are 3 d ln ū/d ln p̄
+#: nodes (:func:`~fastcontact.tables.node_derivatives.local_derivatives`) — no closed form; the average theory's are 3 d ln ū/d ln p̄
 DERIVED_AT_NODES = ("critical_junction", "emt")
 #: nodes per local polynomial (degree 8), chosen in bench/tables_results.md (2026-11-26):
 #: against the degree-4 stencils (effective medium) and central differences (critical junction,
@@ -173,27 +174,6 @@ def _exact(psd, pbar, theories, sig_opts):
     return out
 
 
-def _node_derivative(x, y, ok, width=NODE_STENCIL):
-    """(dy/dx, d²y/dx²) at the open nodes from the polynomial of degree width - 1 through the
-    ``width`` nearest open nodes (one-sided at the ends of the open range)."""
-    d = np.zeros_like(y)
-    d2 = np.zeros_like(y)
-    idx = np.flatnonzero(ok)
-    m = idx.size
-    if m < 3:
-        return d, d2
-    w = min(width, m)
-    k = np.arange(m)
-    lo = np.clip(k - w // 2, 0, m - w)
-    sten = idx[lo[:, None] + np.arange(w)[None, :]]            # (m, w) node indices
-    dx = x[sten] - x[idx][:, None]                             # local abscissae
-    V = dx[:, :, None] ** np.arange(w)[None, None, :]          # Vandermonde (m, w, w)
-    coef = np.linalg.solve(V, y[sten][:, :, None])[:, :, 0]
-    d[idx] = coef[:, 1]
-    d2[idx] = 2.0 * coef[:, 2]
-    return d, d2
-
-
 def _interval_errors(lnp, cols, mids, theories):
     """Relative midpoint errors of each column's interpolant, per interval (inf: overflow)."""
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
@@ -239,8 +219,8 @@ def _sigma_node_derivatives(lnp, cols, theories):
         s = cols[f"sigma_{th}"]
         ok = s > SIGMA_FLOOR
         with np.errstate(divide="ignore"):
-            cols[f"dlnsigma_{th}"], cols[f"d2lnsigma_{th}"] = _node_derivative(
-                lnp, np.where(ok, np.log(np.where(ok, s, 1)), 0), ok)
+            cols[f"dlnsigma_{th}"], cols[f"d2lnsigma_{th}"] = local_derivatives(
+                lnp, np.where(ok, np.log(np.where(ok, s, 1)), 0), ok, NODE_STENCIL)
 
 
 def _flag_intervals(lnp, cols, mids, theories, tol):
