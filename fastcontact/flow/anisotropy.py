@@ -41,6 +41,7 @@ from scipy.interpolate import CubicSpline
 
 from .._core.cache import PerObjectCache
 from .._core.validate import check_positive
+from ..tables.build import NODE_STENCIL
 from ..tables.node_derivatives import local_derivatives
 from ..contact import area_fraction, percolation_pressure
 from ._kernels import EMT_TOL
@@ -270,14 +271,13 @@ DIRECTIONAL_STEMS = ("sigma_emt", "dlnsigma_emt", "d2lnsigma_emt", "phi_emt", "p
 DIRECTIONS = ("x", "y")
 
 
-#: nodes of the local polynomials that give the directional columns' derivatives on the
-#: tables' nodes (degree 8, as the tables' own σ̄), used at table nodes whose two intervals
+#: the directional columns' derivatives on the tables' nodes come from the local polynomials
+#: of the tables' own σ̄ (NODE_STENCIL nodes, degree 8), used at table nodes whose two intervals
 #: are at most DIR_POLY_MAX_H wide in ln p̄ (the default grid of 4 points per decade: 0.576),
 #: else the spline's derivatives. Measured at random pressures (γ_T = 3): default tables
 #: 2.4e-6 with the spline's derivatives, 3e-8 with the polynomials'; an unrefined grid of
 #: 2 per decade (intervals 1.15) 1.9e-5 with the spline's, 1.4e-4 with the polynomials'
 #: (there the quintic Hermite weighs a second-derivative error by h²)
-DIR_STENCIL = 9
 DIR_POLY_MAX_H = 0.6
 
 
@@ -286,7 +286,7 @@ def _columns_on_nodes(tables, d, direction):
     :class:`DirectionalTable` ``d`` (σ̄, its first two ln-derivatives, φ_p, percolated).
 
     The tables' nodes are knots of ``d`` (exact values there); the derivatives come from the
-    local polynomials through the knots (:data:`DIR_STENCIL`, as the tables do for their own
+    local polynomials through the knots (NODE_STENCIL nodes, as the tables do for their own
     σ̄) at nodes whose intervals are at most DIR_POLY_MAX_H wide, else from the spline (whose
     derivatives left the quintic Hermite on tables of 4 points per decade off by 2.4e-6 at
     random pressures; now 3e-8, bench/extensions_results.md)."""
@@ -298,7 +298,7 @@ def _columns_on_nodes(tables, d, direction):
     d1, d2 = spl(lnp, 1), spl(lnp, 2)
     ls = d.lnsig[direction]
     open_ = np.isfinite(ls)
-    k1, k2 = local_derivatives(d.lnp, np.where(open_, ls, 0.0), open_, DIR_STENCIL)
+    k1, k2 = local_derivatives(d.lnp, np.where(open_, ls, 0.0), open_, NODE_STENCIL)
     h = np.diff(lnp)                       # the wider of each node's two intervals
     fine = np.maximum(np.append(h, 0.0), np.append(0.0, h)) <= DIR_POLY_MAX_H
     j = np.clip(np.searchsorted(d.lnp, lnp), 0, d.lnp.size - 1)

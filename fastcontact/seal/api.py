@@ -100,8 +100,6 @@ def _leak_uniform(sc, theory, p0, L, com, alpha_cj):
 
 
 # =========================================================================== profiles
-
-
 def _finish_profile(sc, theory, cols, solve, contact, out, E, ell, dp, L_y, eta, alpha):
     """Q, status, converged and error_estimate of profile rows from the solver outputs."""
     st = np.where(out.status == _panels.ST_NEWTON_FAILED, np.nan, out.W)

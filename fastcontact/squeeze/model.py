@@ -64,10 +64,9 @@ def _tail_fit(tab, x_min, samples=None, theory=None):
     # 3e-11-9e-11 relative, which the tail's ln π = x_min - (v - v_top)/u0 multiplies by
     # (v - v_top)/u0: 7e-9-2.4e-8 at 380 h_rms; now <= 1.3e-9)
     u0 = -v_top * float(tab.dlnu[0])
-    hx = 1e-4
-    sg = _ev(qk.sigma_kernel, tab, np.array([x_min, x_min + hx, x_min + 2 * hx]))
-    sig_top = float(sg[0])
-    dlns_dx = (-3.0 * math.log(sg[0]) + 4.0 * math.log(sg[1]) - math.log(sg[2])) / (2 * hx)
+    sig_top = float(_ev(qk.sigma_kernel, tab, np.array([x_min]))[0])
+    # d ln σ̄/d ln p̄ at the top: likewise the first node's slope (was a one-sided difference)
+    dlns_dx = float(tab.dlnsig[0])
     s1 = sig_top * dlns_dx / (-u0)                    # dσ̄/dv at the top
     y = v_top
     for _ in range(100):                              # 2y³ - s1 y + σ̄ = 0 near v_top

@@ -48,8 +48,10 @@ BOUNDARY_FACTOR = 1e3
 MAX_NODES = 6000
 MIN_DLNP = 1e-6
 #: the theories whose ln σ̄ derivatives at the nodes come from local polynomials through the
-#: nodes (:func:`~fastcontact.tables.node_derivatives.local_derivatives`) — no closed form; the average theory's are 3 d ln ū/d ln p̄
+#: nodes (:func:`~fastcontact.tables.node_derivatives.local_derivatives`; no closed form), and
+#: those columns (not evaluated at midpoints); the average theory's are 3 d ln ū/d ln p̄
 DERIVED_AT_NODES = ("critical_junction", "emt")
+_DERIVED_COLUMNS = frozenset(f"{d}lnsigma_{th}" for th in DERIVED_AT_NODES for d in ("d", "d2"))
 #: nodes per local polynomial (degree 8), chosen in bench/tables_results.md (2026-11-26):
 #: against the degree-4 stencils (effective medium) and central differences (critical junction,
 #: two more quadratures per pressure) used before, 25 % fewer nodes (the refinement towards
@@ -212,7 +214,8 @@ def _interval_errors_raw(lnp, cols, mids, theories):
 
 def _sigma_node_derivatives(lnp, cols, theories):
     """d ln σ̄/d ln p̄ and its derivative of the critical junction and the effective medium at
-    the open nodes (σ̄ > SIGMA_FLOOR), from local polynomials through the nodes (:data:`NODE_STENCIL`)."""
+    the open nodes (σ̄ > SIGMA_FLOOR), from local polynomials through the nodes
+    (:data:`NODE_STENCIL`)."""
     for th in theories:
         if th not in DERIVED_AT_NODES:
             continue
@@ -256,8 +259,8 @@ def _refine(psd, grid, theories, sig_opts, tol, refine):
             new = _exact(psd, np.exp(xm[need]), theories, sig_opts)
             for k, x in enumerate(xm[need]):
                 mid_cache[x] = {c: v[k] for c, v in new.items()}
-        derived = {f"{d}lnsigma_{th}" for th in DERIVED_AT_NODES for d in ("d", "d2")}
-        mids = {c: np.array([mid_cache[x][c] for x in xm]) for c in cols if c not in derived}
+        mids = {c: np.array([mid_cache[x][c] for x in xm]) for c in cols
+                if c not in _DERIVED_COLUMNS}
         if not np.all(np.diff(np.log(np.concatenate(([cols["u"][0]], mids["u"])))) < 0) \
                 or not np.all(np.diff(cols["u"]) < 0):
             raise ValueError(f"grid = {tuple(grid)!r} is invalid for this surface: ū(p) is not "
