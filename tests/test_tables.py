@@ -435,3 +435,60 @@ def test_hermite_kernels_reproduce_a_quintic_and_agree_with_their_numpy_twin():
         assert abs(quintic_np(x, x0, x1, *ends, deriv=True) - P.deriv()(x)) < 1e-12
         val, der = quintic_unit((x - x0) / (x1 - x0), x1 - x0, y0, d0, s0, y1, d1, s1)
         assert abs(val - P(x)) < 1e-13 and abs(der - P.deriv()(x)) < 1e-12
+
+
+def test_spread_order_is_a_permutation_whose_blocks_sample_the_whole_range():
+    """The threads of a prange get contiguous blocks of the work list: in spread order every
+    block is an even sample of the (sorted) pressures, whatever the number of threads."""
+    from fastcontact.kernels.balance import spread_order
+
+    for n in (0, 1, 2, 3, 10, 37, 64, 175):
+        o = spread_order(n)
+        assert sorted(o.tolist()) == list(range(n))
+        for threads in (2, 3, 4):
+            for block in np.array_split(o, threads):
+                if n >= 8 * threads:  # each block's pressures cover the range with small gaps
+                    s = np.sort(block)
+                    assert s[0] < 2 * threads and s[-1] >= n - 2 * threads
+                    assert np.max(np.diff(s)) <= 2 * threads
+
+
+def test_emt_does_not_depend_on_the_order_of_the_pressures(psd):
+    """The pressures are handed to the threads in spread order and put back: reversing the
+    input reverses the output bit for bit."""
+    p = np.exp(np.linspace(math.log(1e-9), math.log(0.3), 23))
+    a = sigma_bar(psd, p, "emt")
+    b = sigma_bar(psd, p[::-1].copy(), "emt")
+    assert np.array_equal(a.sigma_bar, b.sigma_bar[::-1])
+    assert np.array_equal(a.details.u1_evaluations, b.details.u1_evaluations[::-1])
+
+
+def test_emt_started_on_a_neighbours_partition_meets_the_same_tolerance(psd):
+    """A table build starts each midpoint's effective-medium quadrature on a neighbouring
+    node's final partition (:class:`fastcontact.tables.panel_memory.PanelMemory`): the result
+    meets the same tolerance as a cold start, against the independent generalized-medium
+    quadrature of :mod:`fastcontact.validation.emt` (its own Gauss–Legendre rule in A and
+    brentq), and the partition handed back refines the one it started on."""
+    from fastcontact.flow.conductivity import emt_sigma_bar_started
+    from fastcontact.tables.panel_memory import PanelMemory
+    from fastcontact.validation import emt
+
+    nodes = np.exp(np.linspace(math.log(1e-8), math.log(0.2), 6))
+    mem = PanelMemory()
+    cold, final, nfinal = emt_sigma_bar_started(psd, nodes, *mem.starts(np.log(nodes)))
+    mem.add(np.log(nodes), final, nfinal)
+    assert np.all(nfinal >= 4) and np.all(final[np.arange(6), nfinal] == 1.0)
+    mids = np.sqrt(nodes[:-1] * nodes[1:])
+    start, nstart = mem.starts(np.log(mids))
+    assert np.all(nstart == np.minimum(nfinal[:-1], nfinal[1:]))
+    warm, f2, n2 = emt_sigma_bar_started(psd, mids, start, nstart)
+    assert np.all(n2 >= nstart)
+    for i in range(mids.size):  # every starting breakpoint is kept
+        assert np.all(np.isin(start[i, :nstart[i] + 1], f2[i, :n2[i] + 1]))
+    ref = emt.emt_sigma_bar(psd, mids)
+    assert np.all(ref > 0)
+    err = np.abs(warm.sigma_bar / ref - 1)
+    assert np.max(err) < 1e-7, err  # measured 6.9e-8 (the reference's own error), as cold
+    assert np.all(warm.details.error_estimate <= 1e-8)
+    tight = sigma_bar(psd, mids, "emt", tol=1e-12).sigma_bar
+    assert np.max(np.abs(warm.sigma_bar / tight - 1)) < 1e-8

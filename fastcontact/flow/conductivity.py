@@ -28,9 +28,11 @@ from .._core.validate import check_positive, check_range
 from .._core.vocab import DEFAULT_THEORY, THEORIES
 from ..contact import _check_gamma, _check_pbar, _check_psd, _separation, mean_separation
 from ..contact._kernels import PANEL, psd_kernel
+from ..kernels.balance import spread_order
 from ..kernels.quadrature import gauss_hermite, gauss_legendre
 from ..kernels.special import k_table
-from ._kernels import EMT_TOL, EMTSpec, critical_junction_kernel, emt_kernel
+from ._kernels import (EMT_MAX_PANELS, EMT_TOL, EMTSpec, critical_junction_kernel,
+                       emt_kernel_warm)
 
 __all__ = ["THEORIES", "EMT_TOL", "check_theory", "check_emt_threshold", "check_anisotropy", "conductivity", "flow_factor", "sigma_bar",
            "SigmaBar", "SigmaDetails", "Conductivity", "FlowFactor"]
@@ -90,7 +92,9 @@ class FlowFactor(NamedTuple):
 
 @contextlib.contextmanager
 def _dynamic_schedule():
-    """prange hands out one pressure at a time (their costs differ by 100x near percolation)."""
+    """prange splits the pressures into chunks of one (their costs differ by 100x near
+    percolation). The OpenMP and workqueue layers still hand each thread a contiguous block of
+    chunks, so the callers also permute the pressures (:mod:`fastcontact.kernels.balance`)."""
     old = get_parallel_chunksize()
     set_parallel_chunksize(1)
     try:
@@ -163,14 +167,64 @@ def sigma_bar(psd, pbar, theory, *, gamma=1.0, a_perc=0.5, alpha_cj=1.0, n_start
                                      float(panel), u1c, zc, perc)
         return SigmaBar((alpha_cj * u1c / h) ** 3, perc, SigmaDetails(u1c=u1c / h, zeta_c=zc))
     ghx, ghw = gauss_hermite(GH_ORDER)
-    sig = np.empty(pbar.size)
-    err = np.empty(pbar.size)
-    nev = np.empty(pbar.size, dtype=np.int64)
     spec = EMTSpec(float(h), float(gamma), glx, glw, float(panel), bool(almqvist), ghx, ghw,
                    int(n_start), float(tol), emt_threshold)
+    return _emt(sk, pbar, spec, None, None)[0]
+
+
+def _emt(sk, pbar, spec, start, nstart):
+    """(SigmaBar, final partitions, their panel counts) of the effective medium at pbar, the
+    pressures handed to the threads in :func:`~fastcontact.kernels.balance.spread_order`
+    (start None: every quadrature on spec.n_start equal panels)."""
+    n = pbar.size
+    order = spread_order(n)
+    if start is None:
+        start = np.zeros((n, EMT_MAX_PANELS + 1))
+        nstart = np.zeros(n, dtype=np.int64)
+    sig = np.empty(n)
+    err = np.empty(n)
+    nev = np.empty(n, dtype=np.int64)
+    perc = np.empty(n, dtype=np.bool_)
+    final = np.zeros((n, EMT_MAX_PANELS + 1))
+    nfinal = np.zeros(n, dtype=np.int64)
     with _dynamic_schedule():
-        emt_kernel(sk, pbar, k_table(), spec, sig, perc, err, nev)
-    return SigmaBar(sig, perc, SigmaDetails(error_estimate=err, u1_evaluations=nev))
+        emt_kernel_warm(sk, np.ascontiguousarray(pbar[order]), k_table(), spec,
+                        np.ascontiguousarray(start[order], dtype=np.float64),
+                        np.ascontiguousarray(nstart[order], dtype=np.int64), sig, perc, err, nev,
+                        final, nfinal)
+    back = np.argsort(order)
+    return (SigmaBar(sig[back], perc[back],
+                     SigmaDetails(error_estimate=err[back], u1_evaluations=nev[back])),
+            final[back], nfinal[back])
+
+
+def emt_sigma_bar_started(psd, pbar, start, nstart, *, gamma=1.0, tol=EMT_TOL, almqvist=False,
+                          emt_threshold=0.5, n_start=EMT_N_START, **_ignored):
+    """Effective-medium σ̄ as :func:`sigma_bar` (``theory="emt"``), each pressure's adaptive
+    quadrature in A started on given panels (a table build passes each new pressure the final
+    partition of a neighbouring node: the splits that partition already made are not repeated,
+    and the nodes they would discard are not computed). The result meets the same ``tol``.
+
+    Parameters
+    ----------
+    psd, pbar, gamma, tol, almqvist, emt_threshold, n_start
+        As in :func:`sigma_bar` (``pbar`` validated by the caller: contiguous float64).
+    start : ndarray
+        (n, EMT_MAX_PANELS + 1) float64: row i holds the breakpoints 0 = t_0 < ... < t_m = 1 of
+        pressure i's first panels in the graded variable t.
+    nstart : ndarray
+        (n,) int64: m per row; 0 starts on n_start equal panels.
+
+    Returns
+    -------
+    (SigmaBar, final, nfinal)
+        σ̄ as :func:`sigma_bar`; the final partitions in the layout of ``start``.
+    """
+    ghx, ghw = gauss_hermite(GH_ORDER)
+    glx, glw = gauss_legendre()
+    spec = EMTSpec(float(psd.h_rms), float(gamma), glx, glw, float(PANEL), bool(almqvist), ghx,
+                   ghw, int(n_start), float(tol), check_emt_threshold(emt_threshold))
+    return _emt(psd_kernel(psd), pbar, spec, start, nstart)
 
 
 def conductivity(psd, p, E_star, eta, theory=DEFAULT_THEORY, *, gamma=1.0, a_perc=0.5,

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.special import erf
 
 from ..contact._kernels import PANEL, psd_kernel
+from ..kernels.balance import spread_order
 from ..kernels.quadrature import gauss_hermite, gauss_legendre
 from ..kernels.special import k_table
 from ._anisotropic_kernels import directional_kernel, solve_dir, solve_self_consistent, u1_nodes
@@ -123,7 +124,8 @@ def _adaptive(psd, pbar, g, form, gamma, kk, tol):
     ghx, ghw = gauss_hermite(GH_ORDER)
     spec = EMTSpec(float(psd.h_rms), float(gamma), glx, glw, float(PANEL), False, ghx, ghw,
                    int(EMT_N_START), tol, kk / (1.0 + kk))
-    pbar = np.ascontiguousarray(pbar)
+    order = spread_order(pbar.size)  # balanced threads (costs grow towards percolation)
+    pbar = np.ascontiguousarray(np.asarray(pbar)[order])
     sx = np.empty(pbar.size)
     sy = np.empty(pbar.size)
     err = np.empty(pbar.size)
@@ -131,7 +133,8 @@ def _adaptive(psd, pbar, g, form, gamma, kk, tol):
     with _dynamic_schedule():
         directional_kernel(psd_kernel(psd), pbar, k_table(), spec, float(g), float(kk),
                            form == "self_consistent", sx, sy, err, nev)
-    return sx, sy, err, nev
+    back = np.argsort(order)
+    return sx[back], sy[back], err[back], nev[back]
 
 
 def _check(theory, anisotropy, direction, form):

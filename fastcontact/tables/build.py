@@ -17,11 +17,12 @@ from .._core.validate import check_positive, check_range
 from .._core.vocab import THEORIES
 from ..contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
 from ..flow.conductivity import (EMT_TOL, check_anisotropy, check_emt_threshold, check_theory,
-                                 sigma_bar)
+                                 emt_sigma_bar_started, sigma_bar)
 from ..kernels.hermite import quintic_np
 from ..kernels.locate import Grid
 from ..surface.psd import PSD
 from .node_derivatives import local_derivatives
+from .panel_memory import PanelMemory
 from .store import Tables
 
 __all__ = ["precompute", "default_grid", "TOLERANCE", "DEFAULT_POINTS_PER_DECADE", "SIGMA_FLOOR"]
@@ -154,8 +155,10 @@ def _check_tolerance(tolerance):
     return tol
 
 
-def _exact(psd, pbar, theories, sig_opts):
-    """Exact columns at reduced pressures pbar (direct quadrature)."""
+def _exact(psd, pbar, theories, sig_opts, memory=None):
+    """Exact columns at reduced pressures pbar (direct quadrature); with a
+    :class:`~fastcontact.tables.panel_memory.PanelMemory` the effective medium's quadrature
+    starts on a neighbour's final partition and records its own."""
     pbar = np.ascontiguousarray(pbar, dtype=np.float64)
     u, du, d2u = _separation(psd, pbar, 1.0, 1.0, sig_opts["gamma"], second=True)
     h = psd.h_rms
@@ -163,6 +166,11 @@ def _exact(psd, pbar, theories, sig_opts):
     for th in theories:
         if th == "average":  # σ̄ = (ū/h_rms)³ from the quadrature above, not a second one
             sb, perc, extra = out["u"] ** 3, np.zeros(pbar.size, dtype=bool), None
+        elif th == "emt" and memory is not None:
+            lnp = np.log(pbar)
+            (sb, perc, extra), final, nfinal = emt_sigma_bar_started(
+                psd, pbar, *memory.starts(lnp), **sig_opts)
+            memory.add(lnp, final, nfinal)
         else:
             sb, perc, extra = sigma_bar(psd, pbar, th, **sig_opts)
         out[f"sigma_{th}"] = sb
@@ -245,9 +253,12 @@ def _flag_intervals(lnp, cols, mids, theories, tol):
 
 
 def _refine(psd, grid, theories, sig_opts, tol, refine):
-    """Adaptive bisection of the base grid; returns (ln p̄ nodes, columns, errors, stats)."""
+    """Adaptive bisection of the base grid; returns (ln p̄ nodes, columns, errors, stats).
+    The effective medium's quadrature at each midpoint starts on a neighbouring node's final
+    partition (:class:`~fastcontact.tables.panel_memory.PanelMemory`)."""
     lnp = grid.ln_nodes()
-    cols = _exact(psd, np.exp(lnp), theories, sig_opts)
+    memory = PanelMemory()
+    cols = _exact(psd, np.exp(lnp), theories, sig_opts, memory)
     mid_cache = {}
     rounds = 0
     while True:
@@ -256,7 +267,7 @@ def _refine(psd, grid, theories, sig_opts, tol, refine):
         xm = 0.5 * (lnp[:-1] + lnp[1:])
         need = np.array([x not in mid_cache for x in xm])
         if np.any(need):
-            new = _exact(psd, np.exp(xm[need]), theories, sig_opts)
+            new = _exact(psd, np.exp(xm[need]), theories, sig_opts, memory)
             for k, x in enumerate(xm[need]):
                 mid_cache[x] = {c: v[k] for c, v in new.items()}
         mids = {c: np.array([mid_cache[x][c] for x in xm]) for c in cols
