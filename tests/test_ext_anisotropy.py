@@ -193,7 +193,7 @@ def test_adaptive_on_extreme_cases():
         a_c = [0.5, 0.4, 0.6][trial % 3]
         pc = float(fc.contact.percolation_pressure(s, 1.0, 0.5))
         pb = pc * np.concatenate((10 ** rng.uniform(-12, 0.2, 10), [0.999, 1.0, 1.001]))
-        sx, sy, _, nev = _adaptive(s, pb, g, form, 1.0, a_c / (1 - a_c), 1e-8)
+        sx, sy, _, nev = _adaptive(s, pb, g, form, 1.0, a_c / (1 - a_c), 1e-8)[:4]
         rx, ry = directional_sigma_bar(s, pb, g, form=form, n_panels=96, emt_threshold=a_c)
         assert np.all(np.isfinite(sx) & np.isfinite(sy) & (sx >= 0) & (sy >= 0))
         assert np.all(sx >= sy * (1 - 1e-12))

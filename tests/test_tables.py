@@ -465,12 +465,12 @@ def test_emt_does_not_depend_on_the_order_of_the_pressures(psd):
 
 def test_emt_started_on_a_neighbours_partition_meets_the_same_tolerance(psd):
     """A table build starts each midpoint's effective-medium quadrature on a neighbouring
-    node's final partition (:class:`fastcontact.tables.panel_memory.PanelMemory`): the result
+    node's final partition (:class:`fastcontact.flow.panel_memory.PanelMemory`): the result
     meets the same tolerance as a cold start, against the independent generalized-medium
     quadrature of :mod:`fastcontact.validation.emt` (its own Gauss–Legendre rule in A and
     brentq), and the partition handed back refines the one it started on."""
     from fastcontact.flow.conductivity import emt_sigma_bar_started
-    from fastcontact.tables.panel_memory import PanelMemory
+    from fastcontact.flow.panel_memory import PanelMemory
     from fastcontact.validation import emt
 
     nodes = np.exp(np.linspace(math.log(1e-8), math.log(0.2), 6))

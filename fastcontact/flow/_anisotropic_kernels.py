@@ -17,8 +17,8 @@ from numba import njit, prange
 
 from ..contact._kernels import u1_at_area
 from ..kernels.borrow import borrowed
-from ._kernels import (EMT_MAX_PANELS, _area1, emt_panels, emt_split, newton_step, panel_errors,
-                       worst_panel)
+from ._kernels import (EMT_MAX_PANELS, _area1, _sorted_breaks, emt_panels_on, emt_split,
+                       newton_step, panel_errors, worst_panel)
 
 __all__ = ["solve_dir", "solve_self_consistent", "u1_nodes", "directional_adaptive",
            "directional_kernel"]
@@ -176,12 +176,14 @@ def _add_direction(s, lam, pan, npan, spec, pe):
 
 
 @njit(cache=True)
-def directional_adaptive(sk, pbar, ktab, spec, gam, kk, self_consistent):
-    """(σ̄_xx, σ̄_yy, estimated relative error, u1 evaluations) at one reduced pressure with
-    adaptive Gauss–Kronrod panels in A — the nodes, weights and error control of the
-    isotropic :func:`~fastcontact.flow._kernels.emt_sigma` (``spec`` an EMTSpec, whose
-    ``tol`` and ``n_start`` it uses), the solves of :func:`solve_self_consistent`
-    (``self_consistent``) or :func:`solve_dir` with λ = kk γ_T^{±1} ("fixed").
+def directional_adaptive(sk, pbar, ktab, spec, gam, kk, self_consistent, breaks, nb, final):
+    """(σ̄_xx, σ̄_yy, estimated relative error, u1 evaluations, panels) at one reduced
+    pressure with adaptive Gauss–Kronrod panels in A — the nodes, weights and error control of
+    the isotropic :func:`~fastcontact.flow._kernels.emt_sigma_on` (``spec`` an EMTSpec, whose
+    ``tol`` and ``n_start`` it uses; started on the panels breaks[0..nb], nb = 0: n_start equal
+    panels; the final partition's sorted breakpoints into ``final`` when it has room), the
+    solves of :func:`solve_self_consistent` (``self_consistent``) or :func:`solve_dir` with
+    λ = kk γ_T^{±1} ("fixed").
 
     The panel with the largest error (summed over both open directions, each relative to its
     residual's derivative in ln σ̄) is halved until the larger of the two directions'
@@ -193,8 +195,8 @@ def directional_adaptive(sk, pbar, ktab, spec, gam, kk, self_consistent):
     lx = kk if self_consistent else kk * gam
     ly = kk if self_consistent else kk / gam
     if A1 >= lx / (1.0 + lx) and A1 >= ly / (1.0 + ly):
-        return 0.0, 0.0, 0.0, 0
-    pan, npan = emt_panels(sk, pbar, A1, ktab, spec)
+        return 0.0, 0.0, 0.0, 0, 0
+    pan, npan = emt_panels_on(sk, pbar, A1, ktab, spec, breaks, nb)
     sig = pan.nodes.sig
     WK = pan.nodes.wk
     cap = EMT_MAX_PANELS * 15
@@ -216,7 +218,7 @@ def directional_adaptive(sk, pbar, ktab, spec, gam, kk, self_consistent):
             sx = solve_dir(Wc[:n], sc[:n], A1, lx, gx)
             sy = solve_dir(Wc[:n], sc[:n], A1, ly, gy)
         if not (sx > 0.0 or sy > 0.0):
-            return 0.0, 0.0, 0.0, n
+            return 0.0, 0.0, 0.0, n, 0
         gx = math.log(sx) if sx > 0.0 else math.nan
         gy = math.log(sy) if sy > 0.0 else math.nan
         for k in range(npan):
@@ -228,16 +230,23 @@ def directional_adaptive(sk, pbar, ktab, spec, gam, kk, self_consistent):
             est = max(est, _add_direction(sy, ly, pan, npan, spec, pe))
         worst = worst_panel(pe, npan)
         if est <= spec.tol or npan >= EMT_MAX_PANELS or worst < 0:
-            return sx, sy, est, n
+            if final.size > npan:
+                _sorted_breaks(pan, npan, final)
+            return sx, sy, est, n, npan
         npan = emt_split(sk, pbar, A1, ktab, spec, pan, worst, npan)
 
 
 @njit(cache=True, parallel=True)
-def directional_kernel(sk, pbar, ktab, spec, gam, kk, self_consistent, sx, sy, err, nevals):
-    """:func:`directional_adaptive` per reduced pressure into the out arrays."""
+def directional_kernel(sk, pbar, ktab, spec, gam, kk, self_consistent, start, nstart, sx, sy, err,
+                       nevals, final, nfinal):
+    """:func:`directional_adaptive` per reduced pressure into the out arrays, started on
+    start[i, :nstart[i] + 1] (nstart[i] = 0: equal panels), the final partitions into
+    final[i, :nfinal[i] + 1]."""
     for i in prange(pbar.size):
-        a, b, e, m = directional_adaptive(sk, pbar[i], ktab, spec, gam, kk, self_consistent)
+        a, b, e, m, nb = directional_adaptive(sk, pbar[i], ktab, spec, gam, kk, self_consistent,
+                                              start[i], nstart[i], final[i])
         sx[i] = a
         sy[i] = b
         err[i] = e
         nevals[i] = m
+        nfinal[i] = nb

@@ -46,6 +46,7 @@ from ..tables.node_derivatives import local_derivatives
 from ..contact import area_fraction, percolation_pressure
 from ._kernels import EMT_TOL
 from .conductivity import check_emt_threshold, conductivity
+from .panel_memory import PanelMemory
 from .directional import (FORMS, N_PANELS, _adaptive, _check, _odds, directional_sigma_bar,
                           directional_threshold)
 
@@ -184,14 +185,18 @@ def _lnsig(sx, sy, lnp, lnp_perc):
 
 
 def precompute_directional(tables, anisotropy, *, form="self_consistent", n_panels=None,
-                           tol=1e-6, max_rounds=12, sigma_floor=1e-20):
+                           tol=1e-6, max_rounds=12, sigma_floor=1e-20, panel_memory=None):
     """Tabulate σ̄_xx, σ̄_yy (effective medium) of ``tables.surface`` with γ_T = ``anisotropy``.
 
     Starts from the tables' p̄ nodes and bisects every interval whose spline misses the
     direct solver at its midpoint by more than ``tol`` (relative, where σ̄ > sigma_floor),
     up to ``max_rounds`` times; the final midpoint errors go to ``info``. The tables'
-    Yang–Persson γ and effective-medium threshold (``options["emt_threshold"]``, 0.5 when
-    absent; set by a calibration) are reused: the directional thresholds are derived from it.
+    Yang–Persson γ, effective-medium threshold (``options["emt_threshold"]``, 0.5 when
+    absent; set by a calibration) and quadrature tolerance (``options["emt_tol"]``) are
+    reused: the directional thresholds are derived from the threshold. ``panel_memory`` (a
+    :class:`~fastcontact.flow.panel_memory.PanelMemory` of the tables' build, optional) starts
+    the adaptive quadratures at the tables' nodes on the isotropic medium's final partitions
+    there; each midpoint starts on a neighbouring node's directional partition.
 
     Returns
     -------
@@ -212,21 +217,26 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
     lnp_perc = {d: math.log(float(percolation_pressure(psd, 1.0, thr[d]))) for d in thr}
     quad = {"rule": "adaptive Gauss-Kronrod in A" if n_panels is None
             else f"{int(n_panels)} Gauss-Legendre panels of order 10 in A"}
+    emt_tol = float(tables.options.get("emt_tol", EMT_TOL))  # the tables' own
     if n_panels is None:
-        quad.update(tolerance=EMT_TOL, max_error_estimate=0.0, u1_evaluations=0)
+        quad.update(tolerance=emt_tol, max_error_estimate=0.0, u1_evaluations=0)
 
-    def solve(pb):
-        """(σ̄_xx, σ̄_yy) at p̄ = pb; the adaptive quadrature's worst estimate and u1 count
-        are added up in ``quad``."""
+    memory = PanelMemory()  # the directional partitions, by ln p̄
+
+    def solve(pb, start):
+        """(σ̄_xx, σ̄_yy) at p̄ = pb, the adaptive quadratures started from the partitions in
+        ``start``; the worst estimate and u1 count are added up in ``quad``."""
         if n_panels is not None:
             return directional_sigma_bar(psd, pb, g, form=form, gamma=gamma,
                                          n_panels=n_panels, emt_threshold=a_c)
-        a, b, e, m = _adaptive(psd, pb, g, form, gamma, _odds(a_c), EMT_TOL)
+        a, b, e, m, final, nfinal = _adaptive(psd, pb, g, form, gamma, _odds(a_c), emt_tol,
+                                              start)
+        memory.add(np.log(pb), final, nfinal)
         quad["max_error_estimate"] = max(quad["max_error_estimate"], float(np.max(e)))
         quad["u1_evaluations"] += int(np.sum(m))
         return a, b
 
-    sx, sy = solve(np.exp(lnp))
+    sx, sy = solve(np.exp(lnp), panel_memory)
     rounds = 0
     cache = {}                  # exact midpoint values: an unsplit interval keeps its midpoint
     while True:
@@ -236,7 +246,7 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
         xm = 0.5 * (lnp[:-1] + lnp[1:])
         new = np.array([x not in cache for x in xm.tolist()], dtype=bool)
         if np.any(new):
-            nx, ny = solve(np.exp(xm[new]))
+            nx, ny = solve(np.exp(xm[new]), memory)
             cache.update(zip(xm[new].tolist(), zip(nx.tolist(), ny.tolist())))
         mx = np.array([cache[x][0] for x in xm.tolist()])
         my = np.array([cache[x][1] for x in xm.tolist()])

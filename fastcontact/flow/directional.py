@@ -23,7 +23,7 @@ from ..kernels.balance import spread_order
 from ..kernels.quadrature import gauss_hermite, gauss_legendre
 from ..kernels.special import k_table
 from ._anisotropic_kernels import directional_kernel, solve_dir, solve_self_consistent, u1_nodes
-from ._kernels import EMT_TOL, EMTSpec
+from ._kernels import EMT_MAX_PANELS, EMT_TOL, EMTSpec
 from .conductivity import (EMT_N_START, GH_ORDER, _dynamic_schedule, check_anisotropy,
                            check_emt_threshold, check_theory)
 
@@ -114,8 +114,11 @@ def directional_sigma_bar(psd, pbar, anisotropy, *, form="self_consistent", gamm
     return sx, sy
 
 
-def _adaptive(psd, pbar, g, form, gamma, kk, tol):
-    """(σ̄_xx, σ̄_yy, error estimate, u1 evaluations) per p̄ by the adaptive kernel."""
+def _adaptive(psd, pbar, g, form, gamma, kk, tol, memory=None):
+    """(σ̄_xx, σ̄_yy, error estimate, u1 evaluations, final partitions, their panel counts)
+    per p̄ by the adaptive kernel; with a :class:`~fastcontact.flow.panel_memory.PanelMemory`
+    each quadrature starts on a recorded pressure's final partition (the same pressure's, else
+    the neighbour's with fewer panels)."""
     tol = float(tol)
     if not (0.0 < tol < 1.0):
         raise ValueError(f"tol = {tol!r} is invalid: must be in (0, 1) [-] (relative error "
@@ -124,17 +127,26 @@ def _adaptive(psd, pbar, g, form, gamma, kk, tol):
     ghx, ghw = gauss_hermite(GH_ORDER)
     spec = EMTSpec(float(psd.h_rms), float(gamma), glx, glw, float(PANEL), False, ghx, ghw,
                    int(EMT_N_START), tol, kk / (1.0 + kk))
-    order = spread_order(pbar.size)  # balanced threads (costs grow towards percolation)
-    pbar = np.ascontiguousarray(np.asarray(pbar)[order])
-    sx = np.empty(pbar.size)
-    sy = np.empty(pbar.size)
-    err = np.empty(pbar.size)
-    nev = np.empty(pbar.size, dtype=np.int64)
+    pbar = np.ascontiguousarray(pbar, dtype=np.float64)
+    n = pbar.size
+    if memory is None:
+        start, nstart = np.zeros((n, EMT_MAX_PANELS + 1)), np.zeros(n, dtype=np.int64)
+    else:
+        start, nstart = memory.starts(np.log(pbar))
+    order = spread_order(n)  # balanced threads (costs grow towards percolation)
+    sx = np.empty(n)
+    sy = np.empty(n)
+    err = np.empty(n)
+    nev = np.empty(n, dtype=np.int64)
+    final = np.zeros((n, EMT_MAX_PANELS + 1))
+    nfinal = np.zeros(n, dtype=np.int64)
     with _dynamic_schedule():
-        directional_kernel(psd_kernel(psd), pbar, k_table(), spec, float(g), float(kk),
-                           form == "self_consistent", sx, sy, err, nev)
+        directional_kernel(psd_kernel(psd), np.ascontiguousarray(pbar[order]), k_table(), spec,
+                           float(g), float(kk), form == "self_consistent",
+                           np.ascontiguousarray(start[order]),
+                           np.ascontiguousarray(nstart[order]), sx, sy, err, nev, final, nfinal)
     back = np.argsort(order)
-    return sx[back], sy[back], err[back], nev[back]
+    return sx[back], sy[back], err[back], nev[back], final[back], nfinal[back]
 
 
 def _check(theory, anisotropy, direction, form):

@@ -16,13 +16,13 @@ from .._core.jsonable import json_plain
 from .._core.validate import check_positive, check_range
 from .._core.vocab import THEORIES
 from ..contact import _check_gamma, _check_psd, _separation, asymptote, percolation_pressure
-from ..flow.conductivity import (EMT_TOL, check_anisotropy, check_emt_threshold, check_theory,
+from ..flow.conductivity import (check_anisotropy, check_emt_threshold, check_theory,
                                  emt_sigma_bar_started, sigma_bar)
+from ..flow.panel_memory import PanelMemory
 from ..kernels.hermite import quintic_np
 from ..kernels.locate import Grid
 from ..surface.psd import PSD
 from .node_derivatives import local_derivatives
-from .panel_memory import PanelMemory
 from .store import Tables
 
 __all__ = ["precompute", "default_grid", "TOLERANCE", "DEFAULT_POINTS_PER_DECADE", "SIGMA_FLOOR"]
@@ -38,6 +38,14 @@ U_TOP = 32.0
 AREA_TOP = 0.999
 #: relative interpolation tolerances the adaptive refinement enforces at interval midpoints
 TOLERANCE = {"u": 5e-9, "p_of_u": 5e-9, "slope": 5e-8, "sigma": 2e-7}
+#: relative tolerance of the effective-medium quadrature in A at the tables' nodes and
+#: midpoints (the Kronrod–Gauss estimate; the direct :func:`~fastcontact.flow.conductivity.
+#: sigma_bar` keeps EMT_TOL = 1e-8). The refinement's σ̄ tolerance is 2e-7 and the midpoint
+#: quadratures start on their neighbours' partitions, finer than a cold start's: against
+#: tol = 1e-12 the node values were off by <= 1.5e-8 at 1e-7 (<= 1.1e-8 at 1e-8), and at 200
+#: random pressures the six bench spectra's σ̄ errors were the same to two digits at 1e-7 and
+#: at 1e-8 (the road spectrum 2.2e-8 vs 1.2e-8; bench/tables_results.md), the builds ×0.80-0.87
+TABLE_EMT_TOL = 1e-7
 #: σ̄ below this is "at percolation" for the refinement (not resolved further; time scales
 #: there exceed 1e20 τ-units)
 SIGMA_FLOOR = 1e-24
@@ -157,7 +165,7 @@ def _check_tolerance(tolerance):
 
 def _exact(psd, pbar, theories, sig_opts, memory=None):
     """Exact columns at reduced pressures pbar (direct quadrature); with a
-    :class:`~fastcontact.tables.panel_memory.PanelMemory` the effective medium's quadrature
+    :class:`~fastcontact.flow.panel_memory.PanelMemory` the effective medium's quadrature
     starts on a neighbour's final partition and records its own."""
     pbar = np.ascontiguousarray(pbar, dtype=np.float64)
     u, du, d2u = _separation(psd, pbar, 1.0, 1.0, sig_opts["gamma"], second=True)
@@ -252,12 +260,11 @@ def _flag_intervals(lnp, cols, mids, theories, tol):
     return bad, errs
 
 
-def _refine(psd, grid, theories, sig_opts, tol, refine):
+def _refine(psd, grid, theories, sig_opts, tol, refine, memory):
     """Adaptive bisection of the base grid; returns (ln p̄ nodes, columns, errors, stats).
     The effective medium's quadrature at each midpoint starts on a neighbouring node's final
-    partition (:class:`~fastcontact.tables.panel_memory.PanelMemory`)."""
+    partition; ``memory`` (:class:`~fastcontact.flow.panel_memory.PanelMemory`) collects them."""
     lnp = grid.ln_nodes()
-    memory = PanelMemory()
     cols = _exact(psd, np.exp(lnp), theories, sig_opts, memory)
     mid_cache = {}
     rounds = 0
@@ -320,7 +327,7 @@ def _assemble(psd, lnp, cols, theories, options):
 
 
 def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid=None, *,
-               emt_tol=EMT_TOL, emt_almqvist=False, points_per_decade=None, tolerance=None,
+               emt_tol=TABLE_EMT_TOL, emt_almqvist=False, points_per_decade=None, tolerance=None,
                refine=True, emt_threshold=0.5, calibration=None, anisotropy=1.0,
                anisotropy_form="self_consistent"):
     """Tabulate ū (A4), A (A1), u1(ζc) (A3), σ̄ (eq. 23) and φ_p of a surface on a grid of p̄ = p/E*.
@@ -346,7 +353,8 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
     grid : Grid or (log10_min, log10_max, n), optional
         Base p̄ grid (default: :func:`default_grid`).
     emt_tol : float
-        Relative accuracy of the adaptive effective-medium integral [-].
+        Relative accuracy of the adaptive effective-medium integral at the nodes [-]
+        (:data:`TABLE_EMT_TOL`; the direct quadrature's default is 1e-8).
     emt_almqvist : bool
         Almqvist-broadened separation distribution in the effective medium.
     points_per_decade : int, optional
@@ -393,12 +401,14 @@ def precompute(psd, theories=THEORIES, gamma=1.0, a_perc=0.5, alpha_cj=1.0, grid
     aniso = _check_anisotropy(anisotropy, anisotropy_form, theories, options)
     grid = _base_grid(psd, options["gamma"], grid, points_per_decade)
     tol = _check_tolerance(tolerance)
-    lnp, cols, errs, stats = _refine(psd, grid, theories, _sigma_options(options), tol, refine)
+    memory = PanelMemory()
+    lnp, cols, errs, stats = _refine(psd, grid, theories, _sigma_options(options), tol, refine,
+                                     memory)
     data, perc_p, zg = _assemble(psd, lnp, cols, theories, options)
     tail = _tail_samples(psd, float(lnp[0]), theories, _sigma_options(options))
     tables = Tables(psd, theories, options, grid, zg, data, _info(
         psd, options["gamma"], perc_p, errs, tol, lnp.size, stats, t_start, cal_block, tail))
-    return tables if aniso is None else _with_directional(tables, aniso, t_start)
+    return tables if aniso is None else _with_directional(tables, aniso, t_start, memory)
 
 
 def _options(theories, gamma, a_perc, alpha_cj, emt_tol, emt_almqvist, emt_threshold,
@@ -465,10 +475,11 @@ def _info(psd, gamma, perc_p, errs, tol, nodes, stats, t_start, cal_block, tail)
     return info
 
 
-def _with_directional(tables, aniso, t_start):
-    """``tables`` with the σ̄_xx, σ̄_yy columns of γ_T, form = ``aniso`` on their nodes."""
+def _with_directional(tables, aniso, t_start, memory):
+    """``tables`` with the σ̄_xx, σ̄_yy columns of γ_T, form = ``aniso`` on their nodes (the
+    directional quadratures started on the isotropic ones' partitions in ``memory``)."""
     from ..flow.anisotropy import directional_columns, precompute_directional
-    d = precompute_directional(tables, aniso[0], form=aniso[1])
+    d = precompute_directional(tables, aniso[0], form=aniso[1], panel_memory=memory)
     data = dict(tables.data, **directional_columns(tables, d))
     options = dict(tables.options, anisotropy=aniso[0], anisotropy_form=aniso[1])
     info = dict(tables.info, directional=dict(d.info))

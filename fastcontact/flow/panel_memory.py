@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..flow._kernels import EMT_MAX_PANELS
+from ._kernels import EMT_MAX_PANELS
 
 __all__ = ["PanelMemory"]
 
@@ -36,8 +36,10 @@ class PanelMemory:
         right = np.clip(j, 0, self.lnp.size - 1)
         cl, cr = self.count[left], self.count[right]
         # the neighbour with fewer panels (a start with more panels than this pressure needs
-        # computes nodes no split would have asked for); a percolated neighbour (0) never
+        # computes nodes no split would have asked for); a percolated neighbour (0) never; the
+        # pressure itself where it is recorded (another quadrature of the same u1 nodes)
         pick = np.where(((cl <= cr) & (cl > 0)) | (cr == 0), left, right)
+        pick = np.where(self.lnp[right] == lnp, right, pick)
         start[:] = self.breaks[pick]
         nstart[:] = self.count[pick]
         return start, nstart
