@@ -422,7 +422,8 @@ def emt_kernel_warm(sk, pbar, ktab, spec, start, nstart, sigma, percolated, err,
                     nfinal):
     """:func:`emt_kernel` with each pressure's first panels given (start[i, :nstart[i] + 1],
     breakpoints in t; nstart[i] = 0: the equal panels), and each pressure's final partition
-    written to final[i, :nfinal[i] + 1] (sorted breakpoints; nfinal 0 where percolated)."""
+    written to final[i, :nfinal[i] + 1] (sorted breakpoints; nfinal 0 where percolated) when
+    final has the columns (a final of width 0 keeps none)."""
     for i in prange(pbar.size):
         percolated[i] = _area1(sk.cum3, pbar[i]) >= spec.threshold
         s, es, ne, nb = emt_sigma_on(sk, pbar[i], ktab, spec, start[i], nstart[i], final[i])

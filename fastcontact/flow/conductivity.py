@@ -178,14 +178,17 @@ def _emt(sk, pbar, spec, start, nstart):
     (start None: every quadrature on spec.n_start equal panels)."""
     n = pbar.size
     order = spread_order(n)
+    # a cold call (a direct σ̄ of many pressures) neither reads nor keeps partitions: no
+    # (n, EMT_MAX_PANELS + 1) arrays (78 MB each for 1e5 pressures)
+    width = 0 if start is None else EMT_MAX_PANELS + 1
     if start is None:
-        start = np.zeros((n, EMT_MAX_PANELS + 1))
+        start = np.zeros((n, 1))
         nstart = np.zeros(n, dtype=np.int64)
     sig = np.empty(n)
     err = np.empty(n)
     nev = np.empty(n, dtype=np.int64)
     perc = np.empty(n, dtype=np.bool_)
-    final = np.zeros((n, EMT_MAX_PANELS + 1))
+    final = np.zeros((n, width))
     nfinal = np.zeros(n, dtype=np.int64)
     with _dynamic_schedule():
         emt_kernel_warm(sk, np.ascontiguousarray(pbar[order]), k_table(), spec,

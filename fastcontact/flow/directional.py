@@ -129,8 +129,8 @@ def _adaptive(psd, pbar, g, form, gamma, kk, tol, memory=None):
                    int(EMT_N_START), tol, kk / (1.0 + kk))
     pbar = np.ascontiguousarray(pbar, dtype=np.float64)
     n = pbar.size
-    if memory is None:
-        start, nstart = np.zeros((n, EMT_MAX_PANELS + 1)), np.zeros(n, dtype=np.int64)
+    if memory is None:  # equal first panels; the final partitions are still returned
+        start, nstart = np.zeros((n, 1)), np.zeros(n, dtype=np.int64)
     else:
         start, nstart = memory.starts(np.log(pbar))
     order = spread_order(n)  # balanced threads (costs grow towards percolation)
