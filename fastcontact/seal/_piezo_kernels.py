@@ -293,14 +293,19 @@ def _secant(tab, sc, cs, roelands, n, k, slope, tol):
 
 
 @njit(cache=True)
-def _solve_k(tab, sc, cs, roelands, n):
-    """(k, converged) of one Hertz case ``cs`` (:class:`HertzCase`), k = 12 η0 q / h³ [Pa/m].
+def _solve_k(tab, sc, cs, roelands, n, k_guess, slope_guess):
+    """(k, converged, slope) of one Hertz case ``cs`` (:class:`HertzCase`), k = 12 η0 q / h³
+    [Pa/m], and the outlet value's slope df/dk at the root.
 
     The root of the n-step shooting (:func:`_secant`, to 1e-13), started at the root of the
     same shooting with COARSE_STEPS steps (from :func:`_k_start`, to 1e-10) and that root's
     slope: the coarse solve costs about one fine shot, and the fine one then takes ~3–4 shots
     instead of ~10 from the straight-line start (strong contact feedback makes f(k) concave
-    and the first steps overshoot into runaway shots)."""
+    and the first steps overshoot into runaway shots). A finite ``k_guess`` > 0 with
+    ``slope_guess`` < 0 (the root and slope of the same case with fewer steps) replaces the
+    coarse solve: one Newton step from there, then the secant."""
+    if k_guess > 0.0 and k_guess < math.inf and slope_guess < 0.0:
+        return _secant(tab, sc, cs, roelands, n, k_guess, slope_guess, 1e-13)
     k0 = _k_start(tab, sc, cs, roelands)
     if n > 2 * COARSE_STEPS:
         kc, okc, slope = _secant(tab, sc, cs, roelands, COARSE_STEPS, k0, math.nan, 1e-10)
@@ -310,21 +315,25 @@ def _solve_k(tab, sc, cs, roelands, n):
             slope = math.nan
     else:
         slope = math.nan
-    k, ok, _ = _secant(tab, sc, cs, roelands, n, k0, slope, 1e-13)
-    return k, ok
+    return _secant(tab, sc, cs, roelands, n, k0, slope, 1e-13)
 
 
 @njit(cache=True)
-def _hertz_case(tab, sc, E, pH, a, pa, pb, alpha, n):
-    """(k, converged) for one Hertz case with a Barus fluid; k = 12 η0 q / h³ [Pa/m]."""
+def _hertz_case(tab, sc, E, pH, a, pa, pb, alpha, n, k_guess, slope_guess):
+    """(k, converged, slope) for one Hertz case with a Barus fluid; k = 12 η0 q / h³ [Pa/m]
+    (:func:`_solve_k`)."""
     psi_a = pa - pb if alpha == 0.0 else -math.expm1(-alpha * (pa - pb)) / alpha
-    return _solve_k(tab, sc, _case(E, pH, a, pa, pb, psi_a, alpha, 0.0, 0.0, 0.0), False, n)
+    return _solve_k(tab, sc, _case(E, pH, a, pa, pb, psi_a, alpha, 0.0, 0.0, 0.0), False, n,
+                    k_guess, slope_guess)
 
 
 @njit(parallel=True, cache=True)
-def _hertz_kernel(tab, sc, E, pH, a, pa, pb, alpha, n, k, ok):
+def _hertz_kernel(tab, sc, E, pH, a, pa, pb, alpha, n, k_guess, slope_guess, k, ok, slope):
+    """(k, converged, slope) of each O-ring with a Barus fluid by n-step shooting, started
+    from (k_guess, slope_guess) where they are usable (:func:`_solve_k`)."""
     for i in prange(E.size):
-        k[i], ok[i] = _hertz_case(tab, sc, E[i], pH[i], a[i], pa[i], pb[i], alpha[i], n)
+        k[i], ok[i], slope[i] = _hertz_case(tab, sc, E[i], pH[i], a[i], pa[i], pb[i], alpha[i],
+                                            n, k_guess[i], slope_guess[i])
 
 
 # =========================================================================== Roelands
@@ -360,14 +369,17 @@ def _shoot_r(tab, sc, cs, k, n):
 
 
 @njit(cache=True)
-def _hertz_case_r(tab, sc, E, pH, a, pa, pb, A, Z, pr, n):
-    """(k, converged) of one Hertz case with a Roelands fluid (:func:`_solve_k`)."""
-    return _solve_k(tab, sc, _case(E, pH, a, pa, pb, 0.0, 0.0, A, Z, pr), True, n)
+def _hertz_case_r(tab, sc, E, pH, a, pa, pb, A, Z, pr, n, k_guess, slope_guess):
+    """(k, converged, slope) of one Hertz case with a Roelands fluid (:func:`_solve_k`)."""
+    return _solve_k(tab, sc, _case(E, pH, a, pa, pb, 0.0, 0.0, A, Z, pr), True, n, k_guess,
+                    slope_guess)
 
 
 @njit(parallel=True, cache=True)
-def _hertz_kernel_r(tab, sc, rows, pr, n, k, ok):
-    """(k, converged) of each O-ring with a Roelands fluid (:class:`HertzRows`)."""
+def _hertz_kernel_r(tab, sc, rows, pr, n, k_guess, slope_guess, k, ok, slope):
+    """(k, converged, slope) of each O-ring with a Roelands fluid (:class:`HertzRows`),
+    started from (k_guess, slope_guess) where they are usable (:func:`_solve_k`)."""
     for i in prange(rows.E.size):
-        k[i], ok[i] = _hertz_case_r(tab, sc, rows.E[i], rows.pH[i], rows.a[i], rows.pa[i],
-                                    rows.pb[i], rows.A[i], rows.Z[i], pr, n)
+        k[i], ok[i], slope[i] = _hertz_case_r(tab, sc, rows.E[i], rows.pH[i], rows.a[i],
+                                              rows.pa[i], rows.pb[i], rows.A[i], rows.Z[i], pr,
+                                              n, k_guess[i], slope_guess[i])

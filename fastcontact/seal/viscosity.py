@@ -275,7 +275,9 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
                 k, ok = _checked_shooting(_shooter(_hertz_kernel_r, tab, sc, HertzRows(*sub),
                                                    law[2]), k.size, CHECKED_LEVELS)
             else:
-                _hertz_kernel_r(tab, sc, HertzRows(*sub), law[2], int(steps), k, ok)
+                none = np.full(k.size, np.nan)
+                _hertz_kernel_r(tab, sc, HertzRows(*sub), law[2], int(steps), none, none, k, ok,
+                                np.empty(k.size))
         elif steps is None:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, v["alpha_pv"])]
             k, ok = _barus_hertz_k(tables, theory, *sub)
@@ -286,7 +288,8 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
                     CHECKED_LEVELS[1:])
         else:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, v["alpha_pv"])]
-            _hertz_kernel(tab, sc, *sub, int(steps), k, ok)
+            none = np.full(k.size, np.nan)
+            _hertz_kernel(tab, sc, *sub, int(steps), none, none, k, ok, np.empty(k.size))
         kq[run] = k
         conv[run] = ok
     cols = _base_columns(v)
@@ -300,17 +303,20 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
 
 
 def _checked_shooting(shoot, m, levels):
-    """(k, converged) of m O-rings by a shooting ``shoot(n, idx)`` -> (k, ok) of rows idx with n
-    steps, checked: at each level (n1, n2) of ``levels`` the rows still open are shot with n1
-    and n2 steps and keep k(n2) where the two agree within FALLBACK_RTOL (relative; the
-    difference bounds the error of k(n2) for any order >= 1 of the RK4 next to the zone ends);
-    the others go to the next level, and are not converged after the last."""
+    """(k, converged) of m O-rings by a shooting ``shoot(n, idx, k_guess, slope_guess)`` ->
+    (k, ok, slope) of rows idx with n steps, checked: at each level (n1, n2) of ``levels`` the
+    rows still open are shot with n1 and n2 steps and keep k(n2) where the two agree within
+    FALLBACK_RTOL (relative; the difference bounds the error of k(n2) for any order >= 1 of the
+    RK4 next to the zone ends); the others go to the next level, and are not converged after
+    the last. The n2 shooting starts from the n1 root and slope (one Newton step, then the
+    secant, to the same 1e-13) instead of a coarse solve of its own."""
     k = np.full(m, np.nan)
     ok = np.zeros(m, dtype=bool)
     todo = np.arange(m)
     for n1, n2 in levels:
-        k1, ok1 = shoot(n1, todo)
-        k2, ok2 = shoot(n2, todo)
+        none = np.full(todo.size, np.nan)
+        k1, ok1, s1 = shoot(n1, todo, none, none)
+        k2, ok2, _ = shoot(n2, todo, np.where(ok1, k1, np.nan), np.where(ok1, s1, np.nan))
         with np.errstate(invalid="ignore", divide="ignore"):
             agree = ok1 & ok2 & (np.abs(k1 / k2 - 1.0) <= FALLBACK_RTOL)
         k[todo] = k2
@@ -322,15 +328,18 @@ def _checked_shooting(shoot, m, levels):
 
 
 def _shooter(kernel, tab, sc, rows, *extra):
-    """``shoot(n, idx)`` of :func:`_checked_shooting` for a prange shooting kernel called as
-    kernel(tab, sc, *rows[idx], *extra, n, k, ok) (``rows`` a tuple of arrays, or a HertzRows)."""
-    def shoot(n, idx):
+    """``shoot(n, idx, k_guess, slope_guess)`` of :func:`_checked_shooting` for a prange
+    shooting kernel called as kernel(tab, sc, *rows[idx], *extra, n, k_guess, slope_guess, k,
+    ok, slope) (``rows`` a tuple of arrays, or a HertzRows)."""
+    def shoot(n, idx, k_guess, slope_guess):
         k = np.empty(idx.size)
         ok = np.empty(idx.size, dtype=np.bool_)
+        slope = np.empty(idx.size)
         sub = [np.ascontiguousarray(x[idx], dtype=np.float64) for x in rows]
         args = (HertzRows(*sub),) if isinstance(rows, HertzRows) else tuple(sub)
-        kernel(tab, sc, *args, *extra, int(n), k, ok)
-        return k, ok
+        kernel(tab, sc, *args, *extra, int(n), np.ascontiguousarray(k_guess, dtype=np.float64),
+               np.ascontiguousarray(slope_guess, dtype=np.float64), k, ok, slope)
+        return k, ok, slope
     return shoot
 
 
