@@ -230,7 +230,7 @@ def precompute_directional(tables, anisotropy, *, form="self_consistent", n_pane
             return directional_sigma_bar(psd, pb, g, form=form, gamma=gamma,
                                          n_panels=n_panels, emt_threshold=a_c)
         a, b, e, m, final, nfinal = _adaptive(psd, pb, g, form, gamma, _odds(a_c), emt_tol,
-                                              start)
+                                              start, keep=True)
         memory.add(np.log(pb), final, nfinal)
         quad["max_error_estimate"] = max(quad["max_error_estimate"], float(np.max(e)))
         quad["u1_evaluations"] += int(np.sum(m))

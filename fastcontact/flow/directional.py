@@ -114,11 +114,12 @@ def directional_sigma_bar(psd, pbar, anisotropy, *, form="self_consistent", gamm
     return sx, sy
 
 
-def _adaptive(psd, pbar, g, form, gamma, kk, tol, memory=None):
+def _adaptive(psd, pbar, g, form, gamma, kk, tol, memory=None, keep=False):
     """(σ̄_xx, σ̄_yy, error estimate, u1 evaluations, final partitions, their panel counts)
     per p̄ by the adaptive kernel; with a :class:`~fastcontact.flow.panel_memory.PanelMemory`
     each quadrature starts on a recorded pressure's final partition (the same pressure's, else
-    the neighbour's with fewer panels)."""
+    the neighbour's with fewer panels). The partitions are returned with ``keep`` (else an
+    array of width 0: a direct call of many pressures allocates no (n, 97) array)."""
     tol = float(tol)
     if not (0.0 < tol < 1.0):
         raise ValueError(f"tol = {tol!r} is invalid: must be in (0, 1) [-] (relative error "
@@ -129,7 +130,7 @@ def _adaptive(psd, pbar, g, form, gamma, kk, tol, memory=None):
                    int(EMT_N_START), tol, kk / (1.0 + kk))
     pbar = np.ascontiguousarray(pbar, dtype=np.float64)
     n = pbar.size
-    if memory is None:  # equal first panels; the final partitions are still returned
+    if memory is None:  # equal first panels
         start, nstart = np.zeros((n, 1)), np.zeros(n, dtype=np.int64)
     else:
         start, nstart = memory.starts(np.log(pbar))
@@ -138,7 +139,7 @@ def _adaptive(psd, pbar, g, form, gamma, kk, tol, memory=None):
     sy = np.empty(n)
     err = np.empty(n)
     nev = np.empty(n, dtype=np.int64)
-    final = np.zeros((n, EMT_MAX_PANELS + 1))
+    final = np.zeros((n, EMT_MAX_PANELS + 1 if keep else 0))
     nfinal = np.zeros(n, dtype=np.int64)
     with _dynamic_schedule():
         directional_kernel(psd_kernel(psd), np.ascontiguousarray(pbar[order]), k_table(), spec,
