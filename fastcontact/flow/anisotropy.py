@@ -41,8 +41,7 @@ from scipy.interpolate import CubicSpline
 
 from .._core.cache import PerObjectCache
 from .._core.validate import check_positive
-from ..tables.build import NODE_STENCIL
-from ..tables.node_derivatives import local_derivatives
+from ..tables.node_derivatives import NODE_STENCIL, local_derivatives
 from ..contact import area_fraction, percolation_pressure
 from ._kernels import EMT_TOL
 from .conductivity import check_emt_threshold, conductivity

@@ -16,6 +16,7 @@ from ._kernels import EMT_MAX_PANELS
 
 __all__ = ["PanelMemory"]
 
+
 class PanelMemory:
     """Final partitions of the effective-medium quadrature by ln p̄ (sorted)."""
 

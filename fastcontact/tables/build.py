@@ -22,7 +22,7 @@ from ..flow.panel_memory import PanelMemory
 from ..kernels.hermite import quintic_np
 from ..kernels.locate import Grid
 from ..surface.psd import PSD
-from .node_derivatives import local_derivatives
+from .node_derivatives import NODE_STENCIL, local_derivatives
 from .store import Tables
 
 __all__ = ["precompute", "default_grid", "TOLERANCE", "DEFAULT_POINTS_PER_DECADE", "SIGMA_FLOOR"]
@@ -61,13 +61,6 @@ MIN_DLNP = 1e-6
 #: those columns (not evaluated at midpoints); the average theory's are 3 d ln ū/d ln p̄
 DERIVED_AT_NODES = ("critical_junction", "emt")
 _DERIVED_COLUMNS = frozenset(f"{d}lnsigma_{th}" for th in DERIVED_AT_NODES for d in ("d", "d2"))
-#: nodes per local polynomial (degree 8), chosen in bench/tables_results.md (2026-11-26):
-#: against the degree-4 stencils (effective medium) and central differences (critical junction,
-#: two more quadratures per pressure) used before, 25 % fewer nodes (the refinement towards
-#: percolation needs fewer nodes with better derivatives) and a worst random-point error of
-#: σ̄ of 1.5e-7 instead of 5.9e-7 (the critical junction away from percolation: <= 1.5e-7,
-#: was <= 1.3e-8)
-NODE_STENCIL = 9
 
 
 def default_grid(surface: PSD, gamma=1.0, points_per_decade=DEFAULT_POINTS_PER_DECADE) -> Grid:
@@ -163,10 +156,10 @@ def _check_tolerance(tolerance):
     return tol
 
 
-def _exact(psd, pbar, theories, sig_opts, memory=None):
-    """Exact columns at reduced pressures pbar (direct quadrature); with a
-    :class:`~fastcontact.flow.panel_memory.PanelMemory` the effective medium's quadrature
-    starts on a neighbour's final partition and records its own."""
+def _exact(psd, pbar, theories, sig_opts, memory):
+    """Exact columns at reduced pressures pbar (direct quadrature); the effective medium's
+    quadrature starts on a recorded neighbour's final partition and records its own in
+    ``memory`` (:class:`~fastcontact.flow.panel_memory.PanelMemory`)."""
     pbar = np.ascontiguousarray(pbar, dtype=np.float64)
     u, du, d2u = _separation(psd, pbar, 1.0, 1.0, sig_opts["gamma"], second=True)
     h = psd.h_rms
@@ -174,7 +167,7 @@ def _exact(psd, pbar, theories, sig_opts, memory=None):
     for th in theories:
         if th == "average":  # σ̄ = (ū/h_rms)³ from the quadrature above, not a second one
             sb, perc, extra = out["u"] ** 3, np.zeros(pbar.size, dtype=bool), None
-        elif th == "emt" and memory is not None:
+        elif th == "emt":
             lnp = np.log(pbar)
             (sb, perc, extra), final, nfinal = emt_sigma_bar_started(
                 psd, pbar, *memory.starts(lnp), **sig_opts)
