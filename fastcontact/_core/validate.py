@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import decimal
+import math
 import numbers
 import re
 
@@ -276,6 +277,11 @@ def check_positive(name: str, value, unit: str = "", allow_zero: bool = False,
     unit-carrying value (pint Quantity, ...) is converted to it. Returns float64.
     """
     arr = as_float_array(name, value, unit)
+    if arr.size:  # two reductions decide the usual case (NaN propagates through min and max)
+        lo, hi = arr.min(), arr.max()
+        if (lo >= 0.0 if allow_zero else lo > 0.0) and (allow_inf or hi < math.inf) \
+                and hi == hi:
+            return arr
     ok = arr >= 0 if allow_zero else arr > 0
     if not allow_inf:
         ok &= np.isfinite(arr)
@@ -291,6 +297,11 @@ def check_range(name: str, value, lo: float, hi: float, unit: str = "",
                 lo_open: bool = False, hi_open: bool = False) -> np.ndarray:
     """Every element finite and within [lo, hi] (open ends as requested); float64."""
     arr = as_float_array(name, value, unit)
+    if arr.size:  # two reductions decide the usual case (NaN propagates through min and max)
+        a, b = arr.min(), arr.max()
+        if (a > lo if lo_open else a >= lo) and (b < hi if hi_open else b <= hi) \
+                and math.isfinite(a) and math.isfinite(b):
+            return arr
     ok = np.isfinite(arr)
     ok &= (arr > lo) if lo_open else (arr >= lo)
     ok &= (arr < hi) if hi_open else (arr <= hi)

@@ -214,6 +214,6 @@ def ratio_rows(pr, tg):
     t_star's 1.01)."""
     if tg.ratios.size == 0 or tg.ratios[0] != 1.01:
         raise ValueError("the Barus targets must start with t_star's ratio 1.01")
-    rt = row_targets(pr, tg.ratios[1:])
+    rt = row_targets(pr, tg.ratios[1:], tg.dvs)
     r1s = np.ascontiguousarray(np.concatenate(([0.01], tg.ratios[1:] - 1.0)))
     return ZTargets(r1s, np.log(r1s), tg.dvs, rt.lnT), rt.lnTs

@@ -14,23 +14,32 @@ import numpy as np
 from numba import njit, prange
 
 from . import _kernels as qk
-from ._primitive_eval import inverse_constants, z_of_t_at
+from ._primitive_eval import inverse_constants, inverse_constants_ext, tail_top, z_of_t_at
 from .primitive import Primitive, first_row, row_value, stencil, t_of_z
+from ._primitive_eval import lagrange_denominators, t_of_zv
 
 __all__ = ["fast_kernel", "history_kernel", "one_case_primitive", "RowTargets", "row_targets"]
 
-#: per-call tables on the primitive's rows: lnT (nx, 1 + nr) = ln T at the case-independent
-#: targets (t_star: ū = 1.01 ū∞, then the ratios), lnTs (nx) = ln T at the default start.
-#: A case interpolates them in x0 with the same 4-point stencil as everything else, so a
-#: default-start ratio target costs four loads and one exp.
-RowTargets = namedtuple("RowTargets", "lnT lnTs")
+#: per-call tables on the primitive's rows: lnT (nx, 1 + nr + nd) = ln T at the targets
+#: (t_star: ū = 1.01 ū∞, then the nr ratios, then the nd Δu targets at each row's own ū∞),
+#: lnTs (nx) = ln T at the default start, lnTv (nx) = ln T at a start ū = vsh h_rms shared by
+#: every case of the call (NaN where z = ln(vsh/v∞ - 1) < ZV_ROW at that row; size 0 and vsh
+#: NaN when the starts differ). A case interpolates them in x0 with the same 4-point stencil as
+#: everything else, so a target below the start costs four loads and one exp.
+RowTargets = namedtuple("RowTargets", "lnT lnTs lnTv vsh")
 #: the per-call target tables of :func:`fast_kernel` (built in the kernel, before its loop):
 #: r1s = ū/ū∞ - 1 of t_star and the ratios [-], zr = ln r1s, dvs = Δu/h_rms of the Δu
-#: targets [-], lnT the :data:`RowTargets` table of the ratio targets
+#: targets [-], lnT the :data:`RowTargets` table of all the targets
 ZTargets = namedtuple("ZTargets", "r1s zr dvs lnT")
 #: a per-case start within GUARD_Z (in z = ln(ū/ū∞ - 1)) above a target takes the target
-#: from the same interpolant as the start (t_of_z), so that the difference stays >= 0
+#: from the same interpolant as the start (t_of_z), so that the difference stays >= 0; a
+#: target farther below takes its T from the row table
 GUARD_Z = 1.0
+#: a shared start's T comes from the row table ``lnTv`` only where it lies at least this far
+#: above equilibrium (z = ln(ū/ū∞ - 1) >= 1: ū >= 3.7 ū∞) at the case and at each stencil row:
+#: closer to ū∞ the logarithmic singularity of T makes the interpolation across rows at fixed
+#: ū less accurate than t_of_z (measured on the embedded tables: <= 1.3e-8 at z >= 1)
+ZV_ROW = 1.0
 
 
 @njit(cache=True, inline="always")
@@ -43,23 +52,33 @@ def _row_stencil(pr, j):
 
 
 @njit(parallel=True, cache=True)
-def _row_targets_kernel(pr, ratios, lnT, lnTs):
+def _row_targets_kernel(pr, ratios, dvs, vsh, lnT, lnTs, lnTv):
+    nr = ratios.size
     for j in prange(pr.xn.size):
         st = _row_stencil(pr, j)
         vinf = math.exp(pr.lnv[j])
         lnTs[j] = math.log(t_of_z(pr, st, vinf, pr.zs[j]))
+        if lnTv.size:
+            zv = math.log(vsh / vinf - 1.0) if vsh > vinf else -math.inf
+            lnTv[j] = math.log(t_of_zv(pr, st, vinf, zv, vsh)) if zv >= ZV_ROW else math.nan
         for k in range(lnT.shape[1]):
-            r1 = 0.01 if k == 0 else ratios[k - 1] - 1.0
+            r1 = 0.01 if k == 0 else ratios[k - 1] - 1.0 if k <= nr else dvs[k - 1 - nr] / vinf
             lnT[j, k] = math.log(t_of_z(pr, st, vinf, math.log(r1)))
 
 
-def row_targets(pr, ratios):
-    """The :data:`RowTargets` of the primitive ``pr`` for these ratio targets (~1 ms)."""
+def row_targets(pr, ratios, dvs, vsh=math.nan):
+    """The :data:`RowTargets` of the primitive ``pr`` for these ratio targets [-], Δu targets
+    dvs = Δu/h_rms [-] and the start vsh = ū(0)/h_rms [-] shared by every case (NaN: none;
+    +inf is not tabulated) (~1 ms)."""
     ratios = np.ascontiguousarray(ratios, dtype=np.float64)
-    lnT = np.empty((pr.xn.size, 1 + ratios.size))
+    dvs = np.ascontiguousarray(dvs, dtype=np.float64)
+    lnT = np.empty((pr.xn.size, 1 + ratios.size + dvs.size))
     lnTs = np.empty(pr.xn.size)
-    _row_targets_kernel(pr, ratios, lnT, lnTs)
-    return RowTargets(lnT, lnTs)
+    vsh = float(vsh)
+    shared = 0.0 < vsh < math.inf
+    lnTv = np.empty(pr.xn.size if shared else 0)
+    _row_targets_kernel(pr, ratios, dvs, vsh, lnT, lnTs, lnTv)
+    return RowTargets(lnT, lnTs, lnTv, vsh if shared else math.nan)
 
 
 @njit(cache=True, inline="always")
@@ -131,17 +150,22 @@ def _flag_overflow(tau, tg, h, i, out):
 
 
 @njit(cache=True, inline="always")
-def _case_start(pr, st, vinf, vs_in, lnTs):
+def _case_start(pr, st, vinf, vs_in, rt):
     """(zs, v_start, Ts, Ts_row) of a served case: z and ū/h at the start, T at the start from
-    t_of_z (-1: not computed yet) and the default start's T from the row table ``lnTs``
-    (paired with row-table targets only)."""
+    t_of_z (-1: not computed yet) and T at the start from a row table of ``rt`` (the default
+    start's, or a start shared by every case at least ZV_ROW above ū∞; paired with targets at
+    least GUARD_Z below the start only), else from t_of_z."""
     if vs_in != vs_in:
         zs = row_value(pr.zs, st)
-        return zs, vinf * (1.0 + math.exp(zs)), -1.0, math.exp(row_value(lnTs, st))
+        return zs, vinf * (1.0 + math.exp(zs)), -1.0, math.exp(row_value(rt.lnTs, st))
     if vs_in == math.inf:
         return math.inf, vs_in, 0.0, 0.0
     zs = math.log(vs_in / vinf - 1.0)
-    Ts = t_of_z(pr, st, vinf, zs)
+    if vs_in == rt.vsh and zs >= ZV_ROW:
+        Tv = math.exp(row_value(rt.lnTv, st))
+        if Tv == Tv:  # every stencil row at least ZV_ROW above its ū∞
+            return zs, vs_in, -1.0, Tv
+    Ts = t_of_zv(pr, st, vinf, zs, vs_in)
     return zs, vs_in, Ts, Ts
 
 
@@ -152,28 +176,54 @@ def _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, zt):
     or above the start. ``zt`` a :data:`ZTargets`."""
     nr = zt.r1s.size - 1
     r1 = zt.r1s[k] if k <= nr else zt.dvs[k - 1 - nr] / vinf
-    if vinf * (1.0 + r1) >= vs:
+    vt = vinf * (1.0 + r1)
+    if vt >= vs:
         return 0.0, Ts
     z = zt.zr[k] if k <= nr else math.log(r1)
-    if k <= nr and z < zs - GUARD_Z:
+    if z < zs - GUARD_Z:
         return tau * (math.exp(_row_col(zt.lnT, st, k)) - Ts_row), Ts
     if Ts < 0.0:  # near the start: both ends from the same interpolant
-        Ts = t_of_z(pr, st, vinf, zs)
-    return tau * (t_of_z(pr, st, vinf, z) - Ts), Ts
+        Ts = t_of_zv(pr, st, vinf, zs, vs)
+    return tau * (t_of_zv(pr, st, vinf, z, vt) - Ts), Ts
 
 
 @njit(cache=True, inline="always")
-def _u_at(pr, st, vinf, vs, Ts, tt, h, ic):
-    """ū [m] at the reduced time tt = t/τ0 after the start (T(ū) = T(start) + tt); ``ic`` the
-    stencil's :func:`~fastcontact.squeeze._primitive_eval.inverse_constants`."""
+def _u_at(pr, st, vinf, vs, zs, Ts, Ts_row, tt, h, ic):
+    """(ū [m] at the reduced time tt = t/τ0 after the start, Ts): T(ū) = T(start) + tt, the
+    start's T from the row table where ū lands at least GUARD_Z below the start, else from
+    t_of_z (computed here if Ts < 0: the inverse z_of_t pairs with it); ``ic`` the stencil's
+    :func:`~fastcontact.squeeze._primitive_eval.inverse_constants`."""
     if tt == 0.0:
-        return vs * h
+        return vs * h, Ts
     if tt == math.inf:
-        return vinf * h
+        return vinf * h, Ts
+    if Ts < 0.0:
+        z = z_of_t_at(pr, st, vinf, Ts_row + tt, ic)
+        if z < zs - GUARD_Z:
+            return vinf * (1.0 + math.exp(z)) * h, Ts
+        Ts = t_of_zv(pr, st, vinf, zs, vs)
     z = z_of_t_at(pr, st, vinf, Ts + tt, ic)
     # ū(t) <= ū(0): the inverse can land an ulp above the start for t → 0; keeps the ODE's
     # monotonicity (a round-off bound, not a clamp)
-    return min(vinf * (1.0 + math.exp(z)), vs) * h
+    return min(vinf * (1.0 + math.exp(z)), vs) * h, Ts
+
+
+#: cases per block of :func:`fast_kernel`: each stage of the per-case work runs over a block
+#: before the next, so that the CPU overlaps independent cases (one case alone is a chain of
+#: dependent exp/log and interpolations: latency-bound)
+BLOCK = 128
+#: columns of a block's scratch array: the stencil (j0, four weights), v∞, z and v of the
+#: start, T at the start (from t_of_z, -1 not yet), the default start's row-table T, τ0, a
+#: live flag (1: the primitive serves the row), "bad" (τ0 or a time not representable) and
+#: the stencil's inverse constants (five)
+_J0, _W, _VINF, _ZS, _VS, _TS, _TSR, _TAU, _LIVE, _BAD, _IC = 0, 1, 5, 6, 7, 8, 9, 10, 11, 12, 13
+_NSCR = 18
+
+
+@njit(cache=True, inline="always")
+def _st_of(scr, c):
+    """The stencil of block row c (stored as floats: j0 is exact below 2^53)."""
+    return (int(scr[c, _J0]), scr[c, _W], scr[c, _W + 1], scr[c, _W + 2], scr[c, _W + 3])
 
 
 @njit(parallel=True, cache=True)
@@ -182,11 +232,14 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
 
     The records are unpacked into plain arrays before the parallel loop, and the per-case
     work is inline in its body (helpers with ``inline="always"``): a call per case with the
-    records by value costs ten times the arithmetic. Ratio targets (same z for every case)
-    come from the row tables ``rt`` unless the start lies within GUARD_Z above them; there,
-    and for Δu targets, both ends come from t_of_z (one interpolant: the difference is
-    accurate and >= 0 however close the target is to the start); ū at times from its inverse
-    z_of_t."""
+    records by value costs ten times the arithmetic. Each parallel iteration takes a block of
+    :data:`BLOCK` cases through the stages (stencil and v∞; start; each time target; each ū
+    at a time; status) one after the other: within a stage the cases are independent, so the
+    CPU overlaps them (a case alone is latency-bound: ×1.5–1.7 measured on the start stage).
+    Ratio targets (same z for every case) come from the row tables ``rt`` unless the start
+    lies within GUARD_Z above them; there, and for Δu targets, both ends come from t_of_z (one
+    interpolant: the difference is accurate and >= 0 however close the target is to the
+    start); ū at times from its inverse z_of_t."""
     # one field per statement: with tuple unpacking (a, b = rec.a, rec.b) numba 0.6x's parfor
     # lowering keeps only the first array's writes, and a record-field setitem in the loop
     # body (rec.a[i] = x) is lost as well
@@ -208,7 +261,6 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
     dvs = tg.dvs
     times = tg.times
     lnT = rt.lnT
-    lnTs = rt.lnTs
     x_lo, x_hi = mp.x_min, min(mp.x_max, x_fast)
     nT, nU, nr = T_out.shape[0], U_out.shape[0], tg.ratios.size
     per_case_times = times.shape[1] > 1
@@ -217,38 +269,90 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
     r1s[1:] = tg.ratios - 1.0
     zr = np.log(r1s)
     zt = ZTargets(r1s, zr, dvs, lnT)
-    for i in prange(p0.size):
-        tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
-        x0 = math.log(p0[i] / E[i])
-        vs_in = us[i] / h
-        tau0[i] = tau
-        if not (x_lo <= x0 <= x_hi):
-            _slow_row(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
-            continue
-        st = stencil(pr, x0)
-        vinf = math.exp(row_value(pr.lnv, st))
-        if not (vs_in != vs_in or vs_in * h > vinf * h):  # as reported (SI)
-            _below_row(vinf, vs_in, h, x0, i, out)
-            continue
-        zs, vs, Ts, Ts_row = _case_start(pr, st, vinf, vs_in, lnTs)
-        u_inf[i] = vinf * h
-        u_start[i] = vs * h
-        t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
-        u_trap[i] = math.nan
-        t_trap[i] = math.inf
-        flf[i] = 0.0
-        bad = not (0.0 < tau < math.inf)
-        for k in range(nT):
-            tk, Ts = _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, zt)
-            T_out[k, i] = tk
-            bad = bad or tk == math.inf
-        if nU > 0 and Ts < 0.0:
-            Ts = t_of_z(pr, st, vinf, zs)  # the inverse z_of_t pairs with t_of_z
-        ic = inverse_constants(pr, st) if nU > 0 else (0.0, 0.0, 0.0, 0.0, 0.0)
-        for k in range(nU):
-            tt = times[k, i if per_case_times else i - i] / tau
-            U_out[k, i] = _u_at(pr, st, vinf, vs, Ts, tt, h, ic)
-        status[i] = qk.ST_OVERFLOW if bad else qk.ST_OK
+    n = p0.size
+    T_ext = tail_top(pr)
+    for blk in prange((n + BLOCK - 1) // BLOCK):
+        b0 = blk * BLOCK
+        b1 = min(b0 + BLOCK, n)
+        scr = np.empty((b1 - b0, _NSCR))
+        for i in range(b0, b1):  # stage 1: τ0, the stencil and v∞; rows not served
+            c = i - b0
+            tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
+            x0 = math.log(p0[i] / E[i])
+            vs_in = us[i] / h
+            tau0[i] = tau
+            scr[c, _LIVE] = 0.0
+            if not (x_lo <= x0 <= x_hi):
+                _slow_row(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
+                continue
+            st = stencil(pr, x0)
+            vinf = math.exp(row_value(pr.lnv, st))
+            if not (vs_in != vs_in or vs_in * h > vinf * h):  # as reported (SI)
+                _below_row(vinf, vs_in, h, x0, i, out)
+                continue
+            scr[c, _LIVE] = 1.0
+            scr[c, _J0] = st[0]
+            scr[c, _W] = st[1]
+            scr[c, _W + 1] = st[2]
+            scr[c, _W + 2] = st[3]
+            scr[c, _W + 3] = st[4]
+            scr[c, _VINF] = vinf
+            scr[c, _TAU] = tau
+        for i in range(b0, b1):  # stage 2: the start
+            c = i - b0
+            if scr[c, _LIVE] == 0.0:
+                continue
+            st = _st_of(scr, c)
+            vinf = scr[c, _VINF]
+            tau = scr[c, _TAU]
+            zs, vs, Ts, Ts_row = _case_start(pr, st, vinf, us[i] / h, rt)
+            scr[c, _ZS] = zs
+            scr[c, _VS] = vs
+            scr[c, _TS] = Ts
+            scr[c, _TSR] = Ts_row
+            scr[c, _BAD] = 0.0 if 0.0 < tau < math.inf else 1.0
+            u_inf[i] = vinf * h
+            u_start[i] = vs * h
+            t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
+            u_trap[i] = math.nan
+            t_trap[i] = math.inf
+            flf[i] = 0.0
+        for k in range(nT):  # stage 3: the time targets
+            for i in range(b0, b1):
+                c = i - b0
+                if scr[c, _LIVE] == 0.0:
+                    continue
+                tk, Ts = _target_time(pr, _st_of(scr, c), scr[c, _VINF], scr[c, _VS],
+                                      scr[c, _ZS], scr[c, _TS], scr[c, _TSR], scr[c, _TAU], k,
+                                      zt)
+                scr[c, _TS] = Ts
+                T_out[k, i] = tk
+                if tk == math.inf:
+                    scr[c, _BAD] = 1.0
+        if nU > 0:  # stage 4: ū at the times
+            for i in range(b0, b1):
+                c = i - b0
+                if scr[c, _LIVE] == 0.0:
+                    continue
+                ic = inverse_constants_ext(pr, _st_of(scr, c), T_ext)
+                for q in range(5):
+                    scr[c, _IC + q] = ic[q]
+            for k in range(nU):
+                for i in range(b0, b1):
+                    c = i - b0
+                    if scr[c, _LIVE] == 0.0:
+                        continue
+                    tt = times[k, i if per_case_times else i - i] / scr[c, _TAU]
+                    ic = (scr[c, _IC], scr[c, _IC + 1], scr[c, _IC + 2], scr[c, _IC + 3],
+                          scr[c, _IC + 4])
+                    u, Ts = _u_at(pr, _st_of(scr, c), scr[c, _VINF], scr[c, _VS], scr[c, _ZS],
+                                  scr[c, _TS], scr[c, _TSR], tt, h, ic)
+                    U_out[k, i] = u
+                    scr[c, _TS] = Ts
+        for i in range(b0, b1):  # stage 5: status
+            c = i - b0
+            if scr[c, _LIVE] != 0.0:
+                status[i] = qk.ST_OVERFLOW if scr[c, _BAD] != 0.0 else qk.ST_OK
 
 
 @njit(cache=True)
@@ -283,7 +387,8 @@ def one_case_primitive(pr, x0):
         return None, st
     one = (0, 1.0, 0.0, 0.0, 0.0)
     xn = np.array([x0 - 1.0, x0, x0 + 1.0, x0 + 2.0])
-    pr1 = Primitive(xn, float(xn[0]), 1.0, np.arange(4.0), pr.z0, pr.dz, pr.nz,
+    pr1 = Primitive(xn, float(xn[0]), 1.0, np.arange(4.0), lagrange_denominators(xn), pr.z0,
+                    pr.dz, pr.nz,
                     np.ascontiguousarray(_one_row(pr.C, st)), _one_row(pr.lnv, st),
                     _one_row(pr.lnS, st), _one_row(pr.zs, st), _one_row(pr.sx, st),
                     _one_row(pr.lk, st), pr.v_ext, pr.c, pr.d)

@@ -18,7 +18,8 @@ from numba import njit, prange
 from ..kernels.hermite import cubic_basis
 from ..kernels.quadrature import gauss_legendre
 from . import _kernels as qk
-from ._primitive_eval import Primitive, _index_map, row_value, stencil, t_of_z
+from ._primitive_eval import (Primitive, _index_map, lagrange_denominators, row_value, stencil,
+                              t_of_z)
 
 __all__ = ["build", "measure_error", "profile", "fast_limit", "Profile", "DXI", "Z_LO", "DZ",
            "NODE_ORDER", "X_END", "X_FALLBACK"]
@@ -315,8 +316,8 @@ def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, order=NODE_ORDER, check=True):
     nz = int(math.ceil((z_hi - z_lo) / dz)) + 2
     nx = xn.size
     rows = (np.empty(nx) for _ in range(5))  # lnv, lnS, zs, sx, lk
-    pr = Primitive(xn, *_index_map(xn), float(z_lo), float(dz), nz, np.empty((nx, nz, 3)),
-                   *rows, float(mp.v_ext), float(mp.c), float(mp.d))
+    pr = Primitive(xn, *_index_map(xn), lagrange_denominators(xn), float(z_lo), float(dz), nz,
+                   np.empty((nx, nz, 3)), *rows, float(mp.v_ext), float(mp.c), float(mp.d))
     glx, glw = gauss_legendre(order)
     _build_kernel(pf, mp, pr, glx, glw)
     info = {"nx": int(nx), "nz": int(nz), "dxi": float(dxi), "build_seconds":

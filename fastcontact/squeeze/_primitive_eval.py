@@ -17,16 +17,18 @@ from numba import njit
 from ..kernels.hermite import quintic_unit
 from . import _kernels as qk
 
-__all__ = ["Primitive", "first_row", "stencil", "row_value", "row_value_2", "t_of_z", "z_of_t",
-           "z_of_t_at", "inverse_constants"]
+__all__ = ["Primitive", "first_row", "stencil", "row_value", "row_value_2", "t_of_z", "t_of_zv", "z_of_t",
+           "z_of_t_at", "inverse_constants",
+           "inverse_constants_ext", "tail_top"]
 
 #: the tabulated primitive (reduced units). xn (nx) x0 nodes and their locator (blo, bdz,
 #: bidx: fractional row index at uniform x0 samples from blo, step bdz); z0, dz, nz: the z grid; C (nx, nz, 3): ln T, d ln T/dz,
 #: d² ln T/dz²; lnv (nx): ln v∞; lnS (nx): ln of the relaxation time in τ0; zs (nx): z of the
 #: default start; sx (nx): slope dT/d(-z) below the grid; lk (nx): ln κ, the shift of the grid
 #: variable ζ = z + ln κ (κ = (1 + (d ln σ̄/d ln v)² + (d ln π_c/d ln v)²)^½ at v∞, so that
-#: the grid resolves rows where σ̄ collapses); v_ext, c, d: closed-form tail
-Primitive = namedtuple("Primitive", "xn blo bdz bidx z0 dz nz C lnv lnS zs sx lk v_ext c d")
+#: the grid resolves rows where σ̄ collapses); v_ext, c, d: closed-form tail; lag (nx - 3, 4):
+#: :func:`lagrange_denominators`
+Primitive = namedtuple("Primitive", "xn blo bdz bidx lag z0 dz nz C lnv lnS zs sx lk v_ext c d")
 
 
 def _index_map(xn, per_node=8):
@@ -35,6 +37,20 @@ def _index_map(xn, per_node=8):
     xs = np.linspace(xn[0], xn[-1], k + 1)
     return float(xn[0]), float((xn[-1] - xn[0]) / k), np.ascontiguousarray(
         np.interp(xs, xn, np.arange(xn.size, dtype=np.float64)))
+
+
+def lagrange_denominators(xn):
+    """(nx - 3, 4): 1 / Π_{s≠r} (x_{j0+r} - x_{j0+s}) of the 4-point stencil starting at row j0
+    (the per-case weights then need no division)."""
+    m = xn.size - 3
+    lag = np.empty((max(m, 0), 4))
+    for r in range(4):
+        d = np.ones(max(m, 0))
+        for s in range(4):
+            if s != r:
+                d *= xn[r:r + m] - xn[s:s + m]
+        lag[:, r] = 1.0 / d
+    return lag
 
 
 @njit(cache=True, inline="always")
@@ -80,12 +96,12 @@ def stencil(pr, x0):
     if j < 0:
         return -1, 0.0, 0.0, 0.0, 0.0
     j0 = first_row(pr, j)
-    a, b, c, d = pr.xn[j0], pr.xn[j0 + 1], pr.xn[j0 + 2], pr.xn[j0 + 3]
-    w0 = (x0 - b) * (x0 - c) * (x0 - d) / ((a - b) * (a - c) * (a - d))
-    w1 = (x0 - a) * (x0 - c) * (x0 - d) / ((b - a) * (b - c) * (b - d))
-    w2 = (x0 - a) * (x0 - b) * (x0 - d) / ((c - a) * (c - b) * (c - d))
-    w3 = (x0 - a) * (x0 - b) * (x0 - c) / ((d - a) * (d - b) * (d - c))
-    return j0, w0, w1, w2, w3
+    da, db, dc, dd = x0 - pr.xn[j0], x0 - pr.xn[j0 + 1], x0 - pr.xn[j0 + 2], x0 - pr.xn[j0 + 3]
+    lag = pr.lag
+    ab = da * db
+    cd = dc * dd
+    return (j0, db * cd * lag[j0, 0], da * cd * lag[j0, 1], ab * dd * lag[j0, 2],
+            ab * dc * lag[j0, 3])
 
 
 @njit(cache=True, inline="always")
@@ -140,16 +156,23 @@ def _tail_v(pr, T):
 @njit(cache=True, inline="always")
 def _below(pr, st):
     """(T0, h0, S) at the bottom of the z grid for the combined rows."""
-    cf = _cell(pr, st, 0)
-    l0, dl0 = _quintic(0.0, pr.dz, cf)
-    T0 = math.exp(l0)
+    j0, w0, w1, w2, w3 = st
+    C = pr.C  # ln T and d ln T/dz at node 0 (the cell's quintic at its left end)
+    T0 = math.exp(w0 * C[j0, 0, 0] + w1 * C[j0 + 1, 0, 0] + w2 * C[j0 + 2, 0, 0]
+                  + w3 * C[j0 + 3, 0, 0])
+    dl0 = w0 * C[j0, 0, 1] + w1 * C[j0 + 1, 0, 1] + w2 * C[j0 + 2, 0, 1] + w3 * C[j0 + 3, 0, 1]
     return T0, -T0 * dl0, row_value(pr.sx, st)
 
 
 @njit(cache=True, inline="always")
 def t_of_z(pr, st, vinf, z):
     """T(x0, v) at z = ln(v/v∞ - 1) for the stencil st of x0 (v∞ = vinf)."""
-    v = vinf * (1.0 + math.exp(z))
+    return t_of_zv(pr, st, vinf, z, vinf * (1.0 + math.exp(z)))
+
+
+@njit(cache=True, inline="always")
+def t_of_zv(pr, st, vinf, z, v):
+    """:func:`t_of_z` where the caller has v = v∞(1 + e^z) already (saves an exp)."""
     if v >= pr.v_ext:
         return _tail_T(pr, v)
     z = z + row_value(pr.lk, st)
@@ -173,8 +196,20 @@ def z_of_t(pr, st, vinf, T):
 def inverse_constants(pr, st):
     """What :func:`z_of_t_at` needs of the stencil st beyond T: (T at v_ext, ln κ, and T0, h0,
     S of the grid's bottom, :func:`_below`) — computed once for many times of one case."""
+    return inverse_constants_ext(pr, st, tail_top(pr))
+
+
+@njit(cache=True, inline="always")
+def tail_top(pr):
+    """T at v_ext, where the closed-form tail begins (the same for every case of pr)."""
+    return _tail_T(pr, pr.v_ext)
+
+
+@njit(cache=True, inline="always")
+def inverse_constants_ext(pr, st, T_ext):
+    """:func:`inverse_constants` with T_ext = :func:`tail_top` given (hoisted out of a loop)."""
     T0, h0, S = _below(pr, st)
-    return _tail_T(pr, pr.v_ext), row_value(pr.lk, st), T0, h0, S
+    return T_ext, row_value(pr.lk, st), T0, h0, S
 
 
 @njit(cache=True, inline="always")
@@ -204,7 +239,6 @@ def z_of_t_at(pr, st, vinf, T, ic):
                 break
         return z - lk
     lt = math.log(T)
-    # bracket: combined ln T at the nodes decreases with k
     lo = 0
     hi = pr.nz - 1
     y_lo = row_value_2(pr.C, st, lo)
@@ -245,37 +279,58 @@ def _inverse_guess(cf, h, y_lo, y_hi, lt):
     return t if 0.0 < t < 1.0 else s
 
 
-#: a Newton step of at most this (in the cell variable t) ends the iteration, its result taken:
-#: the step after it would be ~ |f''/(2f')| · 1e-16, below the round-off of ln T
-NEWTON_ACCEPT = 1e-8
+#: a Halley step of at most this (in the cell variable t) ends the cell's iteration, its
+#: result taken: the error after a Halley step is ~ |f‴/(6f′) - (f″/(2f′))²| · step³,
+#: ~1e-15 here, below the round-off of ln T
+HALLEY_ACCEPT = 1e-5
 
 
 @njit(cache=True, inline="always")
 def _newton_cell(cf, h, lt, t):
-    """t in (0, 1) with the cell's quintic ln T(t) = lt: safeguarded Newton from ``t`` (bisection
-    where a step leaves the bracket). A Newton step <= NEWTON_ACCEPT ends it (quadratic
-    convergence: the result's error is ~ its square); a bracket or bisection step below 1e-13
-    (Δz <= 2.5e-14) ends it too — asking for less than the round-off of ln T
+    """t in (0, 1) with the cell's quintic ln T(t) = lt: safeguarded Halley iteration from ``t``
+    (bisection where a step leaves the bracket). The quintic is taken in monomial form about
+    the cell's left end (coefficients from its end values and derivatives, the value
+    difference y1 - y0 formed first), so that an iteration is ~15 multiply-adds for f, f′ and
+    f″. A step <= HALLEY_ACCEPT ends it (cubic convergence: one evaluation from the
+    inverse-Hermite start, whose error is ~1e-5, in most cells); a bracket or bisection step
+    below 1e-13 (Δz <= 2.5e-14) ends it too — asking for less than the round-off of ln T
     (~1e-15 |ln T| / |d ln T/dt|) would only stall the iteration."""
+    y0, d0, s0, y1, d1, s1 = cf
+    dy = y1 - y0
+    a1 = h * d0
+    a2 = 0.5 * h * h * s0
+    b1 = h * d1
+    b2 = 0.5 * h * h * s1
+    c3 = 10.0 * dy - 6.0 * a1 - 3.0 * a2 - 4.0 * b1 + b2
+    c4 = -15.0 * dy + 8.0 * a1 + 3.0 * a2 + 7.0 * b1 - 2.0 * b2
+    c5 = 6.0 * dy - 3.0 * a1 - a2 - 3.0 * b1 + b2
+    g = y0 - lt
     a, b = 0.0, 1.0
     for _ in range(60):
-        val, der = _quintic(t, h, cf)
-        f = val - lt
+        f = g + t * (a1 + t * (a2 + t * (c3 + t * (c4 + t * c5))))
         if f == 0.0:
             break
         if f > 0.0:
             a = t
         else:
             b = t
-        tn = t - f / (der * h) if der != 0.0 else 0.5 * (a + b)
-        newton = a < tn < b
-        if not newton:
+        f1 = a1 + t * (2.0 * a2 + t * (3.0 * c3 + t * (4.0 * c4 + t * 5.0 * c5)))
+        f2 = 2.0 * a2 + t * (6.0 * c3 + t * (12.0 * c4 + t * 20.0 * c5))
+        den = f1 - 0.5 * f * f2 / f1 if f1 != 0.0 else 0.0
+        tn = t - f / den if den != 0.0 else 0.5 * (a + b)
+        halley = a < tn < b
+        if not halley:
             tn = 0.5 * (a + b)
         step = abs(tn - t)
         t = tn
-        if (newton and step <= NEWTON_ACCEPT) or step <= 1e-13 or b - a <= 1e-13:
+        if (halley and step <= HALLEY_ACCEPT) or step <= 1e-13 or b - a <= 1e-13:
             break
     return t
+
+
+#: a Newton step of at most this ends an iteration (the Barus primitive's inverse): the step
+#: after it would be ~ |f″/(2f′)| · 1e-16, below the round-off
+NEWTON_ACCEPT = 1e-8
 
 
 @njit(cache=True, inline="always")

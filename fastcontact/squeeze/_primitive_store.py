@@ -15,7 +15,7 @@ import numpy as np
 from .._core.io import atomic_path
 from .._core.vocab import METADATA_KEY
 from ._primitive_build import build
-from ._primitive_eval import Primitive, _index_map
+from ._primitive_eval import Primitive, _index_map, lagrange_denominators
 
 __all__ = ["load_or_build", "write", "read", "set_primitive_cache", "primitive_path",
            "PRIMITIVE_VERSION"]
@@ -99,11 +99,9 @@ def read(path, expect_key=None):
     mats = {k: np.ascontiguousarray(table.column(k).combine_chunks().flatten().to_numpy()
                                     .reshape(-1, nz), dtype=np.float64) for k in ("L", "D1", "D2")}
     xn = col["x0"]
-    pr = Primitive(xn, *_index_map(xn), float(meta["z0"]),
-                   float(meta["dz"]), nz,
-                   np.ascontiguousarray(np.stack([mats["L"], mats["D1"], mats["D2"]], axis=2)),
-                   col["ln_v_inf"],
-                   col["ln_S"], col["z_start"], col["slope_below"], col["ln_kappa"],
-                   float(meta["v_ext"]),
-                   float(meta["c"]), float(meta["d"]))
+    C = np.ascontiguousarray(np.stack([mats["L"], mats["D1"], mats["D2"]], axis=2))
+    pr = Primitive(xn, *_index_map(xn), lagrange_denominators(xn), float(meta["z0"]),
+                   float(meta["dz"]), nz, C,
+                   col["ln_v_inf"], col["ln_S"], col["z_start"], col["slope_below"],
+                   col["ln_kappa"], float(meta["v_ext"]), float(meta["c"]), float(meta["d"]))
     return pr, meta["info"]

@@ -134,8 +134,11 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad):
         quad_kernel(model.tab, model.mp, cs, model.h_rms, tg, quad, out)
     else:
         pr = model.primitive()
-        fast_kernel(model.tab, model.mp, pr, row_targets(pr, tg.ratios), fast_limit(model), cs,
-                    model.h_rms, tg, quad, out)
+        us = cs.us
+        shared = us.size > 1 and us.min() == us.max()  # one start for all (NaN: never equal)
+        rt = row_targets(pr, tg.ratios, tg.dvs, us[0] / model.h_rms if shared else math.nan)
+        fast_kernel(model.tab, model.mp, pr, rt, fast_limit(model), cs, model.h_rms, tg, quad,
+                    out)
     return out
 
 

@@ -12,8 +12,9 @@ so that z-interpolation is quintic Hermite and x0-interpolation 4-point Lagrange
 the grid (the logarithmic singularity at v∞) T = T0 + S (z0 - z) + (h0 - S)(1 - e^{z - z0})
 analytically. Between the table top and v_ext σ̄ is the tail fitted to the tables' direct
 samples (:mod:`.model`); above v_ext (the flat-film tail, σ̄ = y³ - c y within 1e-8 of that
-fit, π_c/π0 < e^-40) T is the closed form ∫dy/(y³ - c y). The inverse (v at a given T) is a bracketed Newton solve on the
-same interpolant, so forward and inverse agree to rounding and ū(t) is monotone.
+fit, π_c/π0 < e^-40) T is the closed form ∫dy/(y³ - c y). The inverse (v at a given T) is a
+bracketed Halley solve on the same interpolant, so forward and inverse agree to rounding and
+ū(t) is monotone.
 
 A primitive is built in one parallel pass (node quadrature, composite Gauss–Legendre in z),
 and can be written to / read from Parquet with its grid and its measured interpolation error.

@@ -50,7 +50,7 @@ from .api import _check_method, attrs, run_cases, squeeze_history, squeeze_out, 
 from .model import squeeze_model
 from .primitive import fast_limit
 from ._fastpath import history_kernel, one_case_primitive
-from .reduced import inertia_time_constant
+from .reduced import inertia_tau
 
 __all__ = ["tire_footprint", "tire_history", "tire_columns", "profile_factors",
            "pressure_profile", "squeeze_method", "PAPER_TIRE"]
@@ -200,7 +200,7 @@ def _inertia_columns(b, p_eval, u_used, h_rms, out):
     """``tau_inertia`` τ' = (D²ρ/(64 p_eval))^{1/2} [s] (D = 2R) and ``t_star_inertia``
     τ' ln(ū(0)/h_rms) [s] (NaN where ū(0) is unknown or <= h_rms) into ``out`` — Sec. 5."""
     n = p_eval.size
-    tau = np.asarray(inertia_time_constant(2.0 * b["R"], b["rho"], p_eval), float) * np.ones(n)
+    tau = inertia_tau(2.0 * b["R"], b["rho"], p_eval)  # inputs validated: n values
     out["tau_inertia"] = tau
     u0 = u_used if u_used is not None else np.full(n, np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
