@@ -227,7 +227,7 @@ def _st_of(scr, c):
 
 
 @njit(parallel=True, cache=True)
-def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
+def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
     """method="fast": every case from the primitive (fall-back rows by quadrature).
 
     The records are unpacked into plain arrays before the parallel loop, and the per-case
@@ -239,7 +239,8 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
     Ratio targets (same z for every case) come from the row tables ``rt`` unless the start
     lies within GUARD_Z above them; there, and for Δu targets, both ends come from t_of_z (one
     interpolant: the difference is accurate and >= 0 however close the target is to the
-    start); ū at times from its inverse z_of_t."""
+    start); ū at times from its inverse z_of_t. ``relax=False`` leaves t_relax NaN on the
+    served rows."""
     # one field per statement: with tuple unpacking (a, b = rec.a, rec.b) numba 0.6x's parfor
     # lowering keeps only the first array's writes, and a record-field setitem in the loop
     # body (rec.a[i] = x) is lost as well
@@ -313,7 +314,7 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out):
             scr[c, _BAD] = 0.0 if 0.0 < tau < math.inf else 1.0
             u_inf[i] = vinf * h
             u_start[i] = vs * h
-            t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
+            t_relax[i] = tau * math.exp(row_value(pr.lnS, st)) if relax else math.nan
             u_trap[i] = math.nan
             t_trap[i] = math.inf
             flf[i] = 0.0

@@ -118,11 +118,12 @@ def _cases(p0, E_star, R, eta, u_start):
     return qk.Cases(*flat)
 
 
-def run_cases(model, cs, ratios, dvs, times2d, method, quad):
+def run_cases(model, cs, ratios, dvs, times2d, method, quad, relax=True):
     """Evaluate the cases ``cs`` (reduced targets) into a fresh :data:`SqOut` record.
 
     ``times2d`` has shape (n_times, 1) (shared, ascending) or (n_times, n) (per case,
-    ascending along axis 0)."""
+    ascending along axis 0). ``relax=False``: the fast path leaves t_relax NaN on the rows
+    it serves (a caller that does not report it saves an interpolation per case)."""
     n = cs.p0.size
     nt = 1 + ratios.size + dvs.size
     out = qk.SqOut(np.empty((nt, n)), np.empty((times2d.shape[0], n)), *(np.empty(n) for _ in
@@ -138,7 +139,7 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad):
         shared = us.size > 1 and us.min() == us.max()  # one start for all (NaN: never equal)
         rt = row_targets(pr, tg.ratios, tg.dvs, us[0] / model.h_rms if shared else math.nan)
         fast_kernel(model.tab, model.mp, pr, rt, fast_limit(model), cs, model.h_rms, tg, quad,
-                    out)
+                    out, bool(relax))
     return out
 
 
