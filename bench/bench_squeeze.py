@@ -9,7 +9,8 @@ Paths (embedded road tables ``asphalt_024mm``, three theories):
 * ``given start``: per-case ``u_start`` and a Δu target;
 * ``times``: ū at three times from per-case starts;
 * ``tire``: ``tire_footprint`` with every column, distinct pressures, speeds and footprint
-  lengths (ū at each case's own exit time);
+  lengths (ū at each case's own exit time); its error also covers a reference case inside a
+  batch that shares its start (the start's T from the per-call row table);
 * ``history``: ``squeeze_history`` of one case at 1e6 times.
 
 Each path runs with ``method="fast"`` (the time primitive), ``method="quad"`` (per-case
@@ -94,8 +95,11 @@ def references(T):
             t_giv = ref.t_ratio(1.01, v_start=vs)
             t_at = 0.5 * t_giv
             dv_at = ref.v_at(t_at, v_start=vs) - ref.v_inf
+            # a start 10 ū∞ shared by a batch (the tire's row-table start, z = ln 9 >= ZV_ROW)
+            t_sh = 0.5 * ref.t_ratio(1.01, v_start=10.0 * ref.v_inf)
+            dv_sh = ref.v_at(t_sh, v_start=10.0 * ref.v_inf) - ref.v_inf
             rows.append(dict(p0=p0, vs=vs * h, t_def=t_def, t_giv=t_giv, t_at=t_at,
-                             dv_at=dv_at, v_inf=ref.v_inf))
+                             dv_at=dv_at, v_inf=ref.v_inf, t_sh=t_sh, dv_sh=dv_sh))
         out[th] = rows
     return out
 
@@ -118,6 +122,13 @@ def path_errors(T, th, refs, method):
                            footprint_length=t_at, speed=1.0, u_start=r["vs"], method=method)
         dv = (f["u_exit"].iloc[0] - f["u_inf"].iloc[0]) / h
         e["tire"] = max(e["tire"], abs(dv / r["dv_at"] - 1))
+        # the reference case inside a batch that shares its start (row-table start)
+        p0s = r["p0"] * np.array([1.0, 0.9, 1.1])
+        f = tire_footprint(T, p0=p0s, E_star=E, R=R, eta=ETA, theory=th,
+                           footprint_length=r["t_sh"] * tau, speed=1.0,
+                           u_start=10.0 * r["v_inf"] * h, method=method)
+        dv = (f["u_exit"].iloc[0] - f["u_inf"].iloc[0]) / h
+        e["tire"] = max(e["tire"], abs(dv / r["dv_sh"] - 1))
     return e
 
 
