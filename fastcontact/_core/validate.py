@@ -279,8 +279,7 @@ def check_positive(name: str, value, unit: str = "", allow_zero: bool = False,
     arr = as_float_array(name, value, unit)
     if arr.size:  # two reductions decide the usual case (NaN propagates through min and max)
         lo, hi = arr.min(), arr.max()
-        if (lo >= 0.0 if allow_zero else lo > 0.0) and (allow_inf or hi < math.inf) \
-                and hi == hi:
+        if (lo >= 0.0 if allow_zero else lo > 0.0) and (allow_inf or hi < math.inf):
             return arr
     ok = arr >= 0 if allow_zero else arr > 0
     if not allow_inf:

@@ -27,11 +27,8 @@ class PanelMemory:
 
     def starts(self, lnp):
         """(start, nstart) for the pressures ln p̄ = lnp: a neighbour's final partition."""
-        n = lnp.size
-        start = np.zeros((n, EMT_MAX_PANELS + 1))
-        nstart = np.zeros(n, dtype=np.int64)
         if self.lnp.size == 0:
-            return start, nstart
+            return np.zeros((lnp.size, EMT_MAX_PANELS + 1)), np.zeros(lnp.size, dtype=np.int64)
         j = np.searchsorted(self.lnp, lnp)
         left = np.clip(j - 1, 0, self.lnp.size - 1)
         right = np.clip(j, 0, self.lnp.size - 1)
@@ -41,9 +38,7 @@ class PanelMemory:
         # pressure itself where it is recorded (another quadrature of the same u1 nodes)
         pick = np.where(((cl <= cr) & (cl > 0)) | (cr == 0), left, right)
         pick = np.where(self.lnp[right] == lnp, right, pick)
-        start[:] = self.breaks[pick]
-        nstart[:] = self.count[pick]
-        return start, nstart
+        return self.breaks[pick], self.count[pick]  # copies (fancy indexing)
 
     def add(self, lnp, breaks, count):
         """Record the final partitions of the pressures ln p̄ = lnp."""

@@ -158,8 +158,7 @@ def _below(pr, st):
     """(T0, h0, S) at the bottom of the z grid for the combined rows."""
     j0, w0, w1, w2, w3 = st
     C = pr.C  # ln T and d ln T/dz at node 0 (the cell's quintic at its left end)
-    T0 = math.exp(w0 * C[j0, 0, 0] + w1 * C[j0 + 1, 0, 0] + w2 * C[j0 + 2, 0, 0]
-                  + w3 * C[j0 + 3, 0, 0])
+    T0 = math.exp(row_value_2(C, st, 0))
     dl0 = w0 * C[j0, 0, 1] + w1 * C[j0 + 1, 0, 1] + w2 * C[j0 + 2, 0, 1] + w3 * C[j0 + 3, 0, 1]
     return T0, -T0 * dl0, row_value(pr.sx, st)
 

@@ -416,7 +416,12 @@ def inertia_time_constant(D, rho, p0):
     D = check_positive("D", D, "[m]")
     rho = check_positive("rho", rho, "[kg/m^3]")
     p0 = check_positive("p0", p0, "[Pa]")
-    return _scalar_or_array(np.sqrt(D**2 * rho / (64.0 * p0)))
+    return _scalar_or_array(inertia_tau(D, rho, p0))
+
+
+def inertia_tau(D, rho, p0):
+    """τ' of :func:`inertia_time_constant` [s] for validated float64 arrays (no checks)."""
+    return np.sqrt(D**2 * rho / (64.0 * p0))
 
 
 def inertia_squeeze_time(D, rho, p0, u_start, h_rms):

@@ -42,7 +42,6 @@ import math
 
 import numpy as np
 import pandas as pd
-from numba import njit, prange
 
 from .._core.validate import as_float_array, check_positive
 from .._core.vocab import DEFAULT_THEORY, column_name
@@ -51,6 +50,7 @@ from .api import _check_method, attrs, run_cases, squeeze_history, squeeze_out, 
 from .model import squeeze_model
 from .primitive import fast_limit
 from ._fastpath import history_kernel, one_case_primitive
+from .reduced import inertia_tau
 
 __all__ = ["tire_footprint", "tire_history", "tire_columns", "profile_factors",
            "pressure_profile", "squeeze_method", "PAPER_TIRE"]
@@ -151,31 +151,17 @@ def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
     r = np.asarray(ratios, dtype=np.float64)
     sq = run_cases(model, cs, r, np.array([du_complete / model.h_rms]),
                    np.ascontiguousarray(t_fp[None, :]), method, quad, relax=False)
-    du_exit, complete = np.empty(n), np.empty(n, dtype=np.bool_)
-    trapped, oot = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
-    _exit_kernel(sq.U[0], sq.u_inf, sq.status, sq.u_trap, du_complete, du_exit, complete,
-                 trapped, oot)
+    du_exit = sq.U[0] - sq.u_inf
+    with np.errstate(invalid="ignore"):
+        complete = du_exit <= du_complete
     out.update(u_inf=sq.u_inf, u_start=sq.u_start, t_du=sq.T[1 + r.size], t_star=sq.T[0],
-               trapped=trapped, u_trap=sq.u_trap, fluid_load_fraction=sq.flf,
-               out_of_table=oot, status=status_column(sq.status), u_exit=sq.U[0],
-               du_exit=du_exit, squeeze_complete=complete)
+               trapped=qk.trapped_mask(sq.status, sq.u_trap), u_trap=sq.u_trap,
+               fluid_load_fraction=sq.flf, out_of_table=sq.status == qk.ST_OUT,
+               status=status_column(sq.status), u_exit=sq.U[0], du_exit=du_exit,
+               squeeze_complete=complete)
     for k, name in enumerate(_ratio_names(ratios)):
         out[name] = sq.T[1 + k]
     return model
-
-
-@njit(parallel=True, cache=True)
-def _exit_kernel(u_exit, u_inf, status, u_trap, du_complete, du_exit, complete, trapped, oot):
-    """The per-case exit columns in one pass: du_exit = ū_exit - ū∞ [m], squeeze_complete
-    (du_exit <= du_complete; False for NaN), ``trapped`` (:func:`~._kernels.trapped_mask`)
-    and ``out_of_table``."""
-    for i in prange(u_exit.size):
-        d = u_exit[i] - u_inf[i]
-        du_exit[i] = d
-        complete[i] = d <= du_complete
-        s = status[i]
-        trapped[i] = s == qk.ST_TRAPPED or (s == qk.ST_OVERFLOW and math.isfinite(u_trap[i]))
-        oot[i] = s == qk.ST_OUT
 
 
 def _check_options(pressure_profile, pressure_model, du_complete, ratios, columns):
@@ -212,23 +198,13 @@ def _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
 def _inertia_columns(b, p_eval, u_used, h_rms, out):
     """``tau_inertia`` τ' = (D²ρ/(64 p_eval))^{1/2} [s] (D = 2R) and ``t_star_inertia``
     τ' ln(ū(0)/h_rms) [s] (NaN where ū(0) is unknown or <= h_rms) into ``out`` — Sec. 5."""
-    n = p_eval.size
-    u0 = u_used if u_used is not None else np.full(n, np.nan)
-    tau, tstar = np.empty(n), np.empty(n)
-    _inertia_kernel(b["R"], b["rho"], p_eval, u0, float(h_rms), tau, tstar)
+    tau = inertia_tau(2.0 * b["R"], b["rho"], p_eval)  # inputs validated: n values
     out["tau_inertia"] = tau
-    out["t_star_inertia"] = tstar
-
-
-@njit(parallel=True, cache=True)
-def _inertia_kernel(R, rho, p, u0, h_rms, tau, tstar):
-    """τ' = (D²ρ/(64 p))^{1/2} with D = 2R (:func:`~.reduced.inertia_time_constant`, inputs
-    validated) and τ' ln(ū(0)/h_rms), NaN where ū(0) <= h_rms or unknown, in one pass."""
-    for i in prange(R.size):
-        D = 2.0 * R[i]
-        t = math.sqrt(D * D * rho[i] / (64.0 * p[i]))
-        tau[i] = t
-        tstar[i] = t * math.log(u0[i] / h_rms) if u0[i] > h_rms else math.nan
+    if u_used is None:
+        out["t_star_inertia"] = np.full(p_eval.size, np.nan)
+        return
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out["t_star_inertia"] = np.where(u_used > h_rms, tau * np.log(u_used / h_rms), np.nan)
 
 
 def _footprint_frame(out, columns, n, model, method):
