@@ -62,3 +62,42 @@ def test_history_matches_squeeze_history(T):
     np.testing.assert_array_equal(a["u"], b["u"])
     assert np.all(np.diff(a["u"]) <= 0) and np.all(a["du"] >= 0)
     assert a.attrs["units"]["du"] == "m"
+
+
+@pytest.mark.parametrize("method", ["fast", "quad"])
+def test_columns_select_what_the_kernel_computes(T, method, monkeypatch):
+    """A study asking for some columns gets them equal to the full call's, and the engine
+    computes only the targets they need (the run_cases call is spied on)."""
+    import fastcontact.squeeze.tire as tire_mod
+
+    rng = np.random.default_rng(11)
+    n = 40
+    kw = dict(p0=rng.uniform(0.05e6, 0.5e6, n), E_star=E, R=rng.uniform(0.005, 0.03, n),
+              eta=10.0 ** rng.uniform(-3, 0, n), footprint_length=rng.uniform(0.05, 0.2, n),
+              speed=rng.uniform(5, 40, n), theory="average", method=method)
+    full = tire_footprint(T, **kw)
+    calls = []
+    real = tire_mod.run_cases
+
+    def spy(model, cs, ratios, dvs, times2d, *a, **k):
+        calls.append((tuple(ratios), dvs.size, times2d.shape[0]))
+        return real(model, cs, ratios, dvs, times2d, *a, **k)
+
+    monkeypatch.setattr(tire_mod, "run_cases", spy)
+    cases = {("t_star", "status"): ((), 0, 0),
+             ("t_ratio_1.01", "u_inf"): ((1.01,), 0, 0),
+             ("t_du", "t_ratio_1.1", "t_ratio_1.001"): ((1.1, 1.001), 1, 0),
+             ("squeeze_complete",): ((), 0, 1),
+             ("u_exit", "du_exit", "trapped"): ((), 0, 1),
+             ("p_eval", "tau_inertia"): None}
+    for cols, targets in cases.items():
+        calls.clear()
+        df = tire_footprint(T, **kw, columns=list(cols))
+        assert list(df.columns) == list(cols)
+        assert calls == ([] if targets is None else [targets]), cols
+        for c in cols:
+            a, b = df[c].to_numpy(), full[c].to_numpy()
+            if a.dtype.kind in "fc":
+                np.testing.assert_allclose(a, b, rtol=1e-7, err_msg=c)
+            else:
+                assert (a == b).all(), c

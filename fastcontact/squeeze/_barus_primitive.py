@@ -49,7 +49,7 @@ from ..kernels.quadrature import gauss_legendre
 from . import _kernels as qk
 from ._primitive_build import _pstate, fast_limit, profile
 from ..kernels.hermite import cubic_basis
-from ._primitive_eval import NEWTON_ACCEPT, _index_map, _locate, z_of_t_at
+from ._primitive_eval import NEWTON_ACCEPT, _index_map, _locate, one_plus_exp, z_of_t_at
 
 __all__ = ["API_FAST", "K_MAX", "SERIES_TOL", "BarusTable", "build", "h_coefficients", "h_series",
            "series_order", "shift", "s_value", "u_at_time"]
@@ -191,7 +191,7 @@ def u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic):
     tau = Ts + tt
     for _ in range(40):
         z = z_of_t_at(pr, st, vinf, tau, ic)
-        v = vinf * (1.0 + math.exp(z))
+        v = vinf * one_plus_exp(z)
         s, lnp = s_value(bt, E, K, x0, v)
         f = tau + A * s - target
         step = f / _inv_g(c, K, A * -math.expm1(lnp - x0))
@@ -199,7 +199,7 @@ def u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic):
         if abs(step) <= NEWTON_ACCEPT * tau:
             break
     z = z_of_t_at(pr, st, vinf, tau, ic)
-    return min(vinf * (1.0 + math.exp(z)), vs)
+    return min(vinf * one_plus_exp(z), vs)
 
 
 # =========================================================================== build

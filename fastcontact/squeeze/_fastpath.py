@@ -16,7 +16,7 @@ from numba import njit, prange
 from . import _kernels as qk
 from ._primitive_eval import inverse_constants, inverse_constants_ext, tail_top, z_of_t_at
 from .primitive import Primitive, first_row, row_value, stencil, t_of_z
-from ._primitive_eval import lagrange_denominators, t_of_zv
+from ._primitive_eval import lagrange_denominators, one_plus_exp, t_of_zv
 
 __all__ = ["fast_kernel", "history_kernel", "one_case_primitive", "RowTargets", "row_targets"]
 
@@ -202,12 +202,12 @@ def _u_at(pr, st, vinf, vs, zs, Ts, Ts_row, tt, h, ic):
     if Ts < 0.0:
         z = z_of_t_at(pr, st, vinf, Ts_row + tt, ic)
         if z < zs - GUARD_Z:
-            return vinf * (1.0 + math.exp(z)) * h, Ts
+            return vinf * one_plus_exp(z) * h, Ts
         Ts = t_of_zv(pr, st, vinf, zs, vs)
     z = z_of_t_at(pr, st, vinf, Ts + tt, ic)
     # ū(t) <= ū(0): the inverse can land an ulp above the start for t → 0; keeps the ODE's
     # monotonicity (a round-off bound, not a clamp)
-    return min(vinf * (1.0 + math.exp(z)), vs) * h, Ts
+    return min(vinf * one_plus_exp(z), vs) * h, Ts
 
 
 #: cases per block of :func:`fast_kernel`: each stage of the per-case work runs over a block
@@ -411,4 +411,4 @@ def history_kernel(pr, st, vs_in, tau, h, t, u):
         elif tk == math.inf:
             u[k] = vinf * h
         else:
-            u[k] = min(vinf * (1.0 + math.exp(z_of_t_at(pr, st, vinf, Ts + tk, ic))), vs) * h
+            u[k] = min(vinf * one_plus_exp(z_of_t_at(pr, st, vinf, Ts + tk, ic)), vs) * h

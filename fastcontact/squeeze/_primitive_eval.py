@@ -19,7 +19,7 @@ from . import _kernels as qk
 
 __all__ = ["Primitive", "first_row", "stencil", "row_value", "row_value_2", "t_of_z", "t_of_zv",
            "z_of_t", "z_of_t_at", "inverse_constants", "inverse_constants_ext", "tail_top",
-           "lagrange_denominators"]
+           "lagrange_denominators", "one_plus_exp", "Z_NEGLIGIBLE"]
 
 #: the tabulated primitive (reduced units). xn (nx) x0 nodes and their locator (blo, bdz,
 #: bidx: fractional row index at uniform x0 samples from blo, step bdz); z0, dz, nz: the z grid; C (nx, nz, 3): ln T, d ln T/dz,
@@ -163,10 +163,21 @@ def _below(pr, st):
     return T0, -T0 * dl0, row_value(pr.sx, st)
 
 
+#: below this z = ln(v/v∞ - 1), e^z < 2^-54: 1 + e^z rounds to 1 exactly
+Z_NEGLIGIBLE = -40.0
+
+
+@njit(cache=True, inline="always")
+def one_plus_exp(z):
+    """1 + e^z, bit for bit, without calling exp where e^z is below half an ulp of 1
+    (z < Z_NEGLIGIBLE; z = -inf included): there libm's exp underflows slowly or is wasted."""
+    return 1.0 + math.exp(z) if z >= Z_NEGLIGIBLE else 1.0
+
+
 @njit(cache=True, inline="always")
 def t_of_z(pr, st, vinf, z):
     """T(x0, v) at z = ln(v/v∞ - 1) for the stencil st of x0 (v∞ = vinf)."""
-    return t_of_zv(pr, st, vinf, z, vinf * (1.0 + math.exp(z)))
+    return t_of_zv(pr, st, vinf, z, vinf * one_plus_exp(z))
 
 
 @njit(cache=True, inline="always")
@@ -228,6 +239,11 @@ def z_of_t_at(pr, st, vinf, T, ic):
         # that then approaches the root monotonically
         d_tan = (T - T0) / h0
         d_asy = (T - T0 - (h0 - S)) / S if S > 0.0 else d_tan
+        if S > 0.0 and (d_asy >= 80.0 or (d_asy >= 40.0 and abs(h0 - S) <= 90.0 * S)):
+            # far below the grid the root is the asymptote's: D - d_asy = (h0 - S)e^-D/S
+            # <= 1e-17 D here, below the round-off of z (the Newton iteration would return
+            # the same z, after exponentials that underflow: slow in libm)
+            return pr.z0 - d_asy - row_value(pr.lk, st)
         z = pr.z0 - (max(d_tan, d_asy) if h0 > S else min(d_tan, d_asy))
         for _ in range(30):  # Newton on the analytic part below the grid
             f = T0 + S * (pr.z0 - z) - (h0 - S) * math.expm1(z - pr.z0) - T

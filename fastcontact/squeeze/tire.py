@@ -141,26 +141,46 @@ def _inputs(p0, E_star, R, eta, footprint_length, speed, rho, u_start, alpha_pv=
             for k, a in arrs.items()}
 
 
-def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out):
-    """The squeeze-out columns of every case in one kernel pass (ū at each case's own exit)."""
+#: the columns that need ū at the footprint exit (one inversion of the time primitive per case)
+_EXIT_COLUMNS = frozenset(("u_exit", "du_exit", "squeeze_complete"))
+
+
+def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out,
+                     want=None):
+    """The squeeze-out columns of every case in one kernel pass (ū at each case's own exit).
+
+    ``want`` (a set of column names; None: all) selects the targets the kernel computes: a
+    ratio target only for its ``t_ratio_<r>`` column, the Δu target only for ``t_du``, the
+    exit only for ``u_exit``, ``du_exit`` or ``squeeze_complete`` (t_star, ū∞, ū(0), the trap
+    and the status always). Every computed column is the same whatever else is asked, to
+    within the primitive's error (the exit's ū can differ by ~1e-8 relative where a near-start
+    target changes which T(ū(0)) it pairs with)."""
     model = squeeze_model(tables, theory)
     n = p_eval.size
     us = b["u_start"] if "u_start" in b else np.full(n, np.nan)
     cs = qk.Cases(np.ascontiguousarray(p_eval), b["E_star"], b["R"], b["eta"], us)
     quad, _ = _check_method(method, 10, 1.0, None)
-    r = np.asarray(ratios, dtype=np.float64)
-    sq = run_cases(model, cs, r, np.array([du_complete / model.h_rms]),
-                   np.ascontiguousarray(t_fp[None, :]), method, quad, relax=False)
-    du_exit = sq.U[0] - sq.u_inf
-    with np.errstate(invalid="ignore"):
-        complete = du_exit <= du_complete
-    out.update(u_inf=sq.u_inf, u_start=sq.u_start, t_du=sq.T[1 + r.size], t_star=sq.T[0],
+    names = _ratio_names(ratios)
+    keep = [k for k, nm in enumerate(names) if want is None or nm in want]
+    r = np.asarray(ratios, dtype=np.float64)[keep]
+    du = want is None or "t_du" in want
+    exit_ = want is None or bool(want & _EXIT_COLUMNS)
+    sq = run_cases(model, cs, r, np.array([du_complete / model.h_rms] if du else []),
+                   np.ascontiguousarray(t_fp[None, :]) if exit_ else np.zeros((0, 1)), method,
+                   quad, relax=False)
+    out.update(u_inf=sq.u_inf, u_start=sq.u_start, t_star=sq.T[0],
                trapped=qk.trapped_mask(sq.status, sq.u_trap), u_trap=sq.u_trap,
                fluid_load_fraction=sq.flf, out_of_table=sq.status == qk.ST_OUT,
-               status=status_column(sq.status), u_exit=sq.U[0], du_exit=du_exit,
-               squeeze_complete=complete)
-    for k, name in enumerate(_ratio_names(ratios)):
-        out[name] = sq.T[1 + k]
+               status=status_column(sq.status))
+    if du:
+        out["t_du"] = sq.T[1 + r.size]
+    if exit_:
+        du_exit = sq.U[0] - sq.u_inf
+        with np.errstate(invalid="ignore"):
+            complete = du_exit <= du_complete
+        out.update(u_exit=sq.U[0], du_exit=du_exit, squeeze_complete=complete)
+    for j, k in enumerate(keep):
+        out[names[k]] = sq.T[1 + j]
     return model
 
 
@@ -183,16 +203,18 @@ def _check_options(pressure_profile, pressure_model, du_complete, ratios, column
     return peak, du_complete, ratios, columns
 
 
-def _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out):
-    """The squeeze-out columns into ``out``: the base engine, or the Barus fluid engine of
-    :mod:`fastcontact.squeeze.tire_piezo` if any row has α > 0 (issue 14). Returns the model."""
+def _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out, want):
+    """The squeeze-out columns into ``out``: the base engine (only the targets of the columns
+    in ``want``), or the Barus fluid engine of :mod:`fastcontact.squeeze.tire_piezo` (every
+    column) if any row has α > 0 (issue 14). Returns the model."""
     if np.any(b["alpha_pv"] > 0.0):
         from .tire_piezo import barus_tire_columns
         return barus_tire_columns(
             tables, b, p_eval, t_fp, theory, ratios, _ratio_names(ratios), du_complete,
             b["alpha_pv"], out, lambda tb, bb, pe, tf, o: _squeeze_columns(
                 tb, bb, pe, tf, theory, ratios, du_complete, method, o), method)
-    return _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out)
+    return _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out,
+                            want)
 
 
 def _inertia_columns(b, p_eval, u_used, h_rms, out):
@@ -261,7 +283,11 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
     ratios : sequence of float, default (1.1, 1.01, 1.001)
         ū/ū∞ of the ``t_ratio_<r>`` columns.
     columns : list of str or None
-        Columns wanted (default all of :func:`tire_columns`).
+        Columns wanted (default all of :func:`tire_columns`). Only what they need is computed:
+        a ratio target for its ``t_ratio_<r>`` column, the Δu target for ``t_du``, ū at the
+        exit for ``u_exit``, ``du_exit`` or ``squeeze_complete``, the squeeze-out itself only
+        if a column beyond ``p_eval``, ``p_peak``, ``t_footprint`` and ``tau_inertia`` is
+        asked (the Barus engine, ``alpha_pv`` > 0, computes every column).
     method : {"fast", "quad"} or None
         Squeeze-out engine (None: :func:`squeeze_method` of the case count).
     alpha_pv : array_like, default 0.0
@@ -295,7 +321,7 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
         if method is None:
             method = squeeze_method(n)
         model = _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method,
-                                 out)
+                                 out, want)
         u_used = out["u_start"]
     if want & {"tau_inertia", "t_star_inertia"}:
         _inertia_columns(b, p_eval, u_used, tables.h_rms, out)
