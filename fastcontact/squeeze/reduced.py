@@ -420,8 +420,14 @@ def inertia_time_constant(D, rho, p0):
 
 
 def inertia_tau(D, rho, p0):
-    """τ' of :func:`inertia_time_constant` [s] for validated float64 arrays (no checks)."""
-    return np.sqrt(D**2 * rho / (64.0 * p0))
+    """τ' of :func:`inertia_time_constant` [s] for validated float64 arrays (no checks), into
+    one new array of their broadcast shape (no temporaries)."""
+    out = np.empty(np.broadcast_shapes(np.shape(D), np.shape(rho), np.shape(p0)))
+    np.multiply(D, D, out=out)
+    out *= rho
+    out /= p0
+    out *= 1.0 / 64.0
+    return np.sqrt(out, out=out)
 
 
 def inertia_squeeze_time(D, rho, p0, u_start, h_rms):

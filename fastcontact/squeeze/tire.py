@@ -137,8 +137,22 @@ def _inputs(p0, E_star, R, eta, footprint_length, speed, rho, u_start, alpha_pv=
     except ValueError:
         raise ValueError(f"{', '.join(arrs)} are invalid: shapes "
                          f"{[np.shape(a) for a in arrs.values()]} do not broadcast") from None
-    return {k: np.ascontiguousarray(np.broadcast_to(a, shape).ravel(), dtype=np.float64)
+    # one value per case, contiguous (the kernel's inputs); ρ and α_pv given as one number
+    # stay 0-d (no array of a million copies): NumPy broadcasts them, and the Barus engine
+    # expands them (_full)
+    return {k: a.reshape(()) if k in _SCALAR_OK and a.size == 1
+            else np.ascontiguousarray(np.broadcast_to(a, shape).ravel(), dtype=np.float64)
             for k, a in arrs.items()}
+
+
+#: inputs of _inputs that may stay 0-d
+_SCALAR_OK = ("rho", "alpha_pv")
+
+
+def _full(b, n):
+    """``b`` with every input one value per case (contiguous, n values)."""
+    return {k: np.ascontiguousarray(np.broadcast_to(v, (n,)), dtype=np.float64)
+            for k, v in b.items()}
 
 
 #: the columns that need ū at the footprint exit (one inversion of the time primitive per case)
@@ -209,6 +223,7 @@ def _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
     column) if any row has α > 0 (issue 14). Returns the model."""
     if np.any(b["alpha_pv"] > 0.0):
         from .tire_piezo import barus_tire_columns
+        b = _full(b, p_eval.size)
         return barus_tire_columns(
             tables, b, p_eval, t_fp, theory, ratios, _ratio_names(ratios), du_complete,
             b["alpha_pv"], out, lambda tb, bb, pe, tf, o: _squeeze_columns(
@@ -226,7 +241,11 @@ def _inertia_columns(b, p_eval, u_used, h_rms, out):
         out["t_star_inertia"] = np.full(p_eval.size, np.nan)
         return
     with np.errstate(invalid="ignore", divide="ignore"):
-        out["t_star_inertia"] = np.where(u_used > h_rms, tau * np.log(u_used / h_rms), np.nan)
+        t = np.divide(u_used, h_rms)  # in place from here: one array per million cases
+        np.log(t, out=t)
+        t *= tau
+    t[~(u_used > h_rms)] = np.nan
+    out["t_star_inertia"] = t
 
 
 def _footprint_frame(out, columns, n, model, method):
