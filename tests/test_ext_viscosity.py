@@ -192,6 +192,81 @@ def test_seal_uniform(tables, theory):
         assert abs(got / (q * L_Y) - 1) < 1e-8
 
 
+@pytest.mark.parametrize("law", ["barus", "roelands"])
+def test_seal_uniform_sweep_matches_per_row(tables, law):
+    """A batch of flat rings (runs of shared p0, p_b, E*, α, each a Δp sweep, plus rows of
+    their own, shuffled) equals every row's integral on its own (the per-row kernel, the
+    sweep's reference, with panels 10x narrower and 16 Gauss points) to 5e-11, as the
+    per-row default rule (GL 10, panels 0.5) does (measured 1.4e-11 and 2.2e-11), and a few
+    rows the separate BVP reference to 1e-8."""
+    from fastcontact.kernels.quadrature import gauss_legendre
+    from fastcontact.seal._piezo_kernels import Quad, _uniform_kernel
+    from fastcontact.seal.viscosity import SWEEP_CHUNK
+
+    rng = np.random.default_rng(3)
+    runs = [(5e4, 0.0, 3e-5, 700), (5e4, 1e3, 3e-5, 300), (3e4, 0.0, 1e-5, 40)]
+    p0, pb, al = [], [], []
+    for a, b, c, m in runs:
+        p0 += [a] * m
+        pb += [b] * m
+        al += [c] * m
+    m = 25  # rows of their own
+    p0 += list(rng.uniform(2e4, 6e4, m))
+    pb += list(rng.uniform(0.0, 1e3, m))
+    al += list(rng.uniform(1e-6, 4e-5, m))
+    p0, pb, al = np.array(p0), np.array(pb), np.array(al)
+    dp = (p0 - pb) * rng.uniform(1e-6, 0.999, p0.size)
+    dp[:5] = 0.999 * (p0[:5] - pb[:5])  # ties and the widest rows of the first run
+    perm = rng.permutation(p0.size)
+    p0, pb, al, dp = p0[perm], pb[perm], al[perm], dp[perm]
+    assert 700 > SWEEP_CHUNK  # the first run spans several chunks
+    kw = dict(p0=p0, dp=dp, p_b=pb, L=5e-3, L_y=L_Y, E_star=E_STAR, eta=ETA, alpha_pv=al,
+              theory="emt", viscosity=law)
+    if law == "roelands":
+        kw["roelands_z"] = 0.6
+    got = seal_leak_piezo(tables, **kw)
+    assert (got.status == "ok").all()
+    # the reference: the per-row kernel on the same rows and the same law
+    import fastcontact.seal.viscosity as sv
+
+    captured = {}
+    real = sv._uniform_sweep_kernel
+
+    def spy(tab, sc, rows, pr, quad, short, starts, out):
+        captured.update(tab=tab, sc=sc, rows=rows, pr=pr, quad=quad, starts=starts)
+        real(tab, sc, rows, pr, quad, short, starts, out)
+        captured["out"] = out.copy()
+
+    sv._uniform_sweep_kernel = spy
+    try:
+        seal_leak_piezo(tables, **kw)
+    finally:
+        sv._uniform_sweep_kernel = real
+    c = captured
+    assert c["starts"].size - 1 >= 3 + m  # runs, their chunks and the single rows
+    ref = np.empty(c["rows"].p0.size)
+    x, w = gauss_legendre(16)
+    _uniform_kernel(c["tab"], c["sc"], c["rows"], c["pr"], Quad(x, w, 0.1 * c["quad"].width),
+                    ref)
+    per_row = np.empty_like(ref)
+    _uniform_kernel(c["tab"], c["sc"], c["rows"], c["pr"], c["quad"], per_row)
+    err_sweep = np.max(np.abs(c["out"] / ref - 1))
+    err_row = np.max(np.abs(per_row / ref - 1))
+    assert err_sweep < 5e-11 and err_row < 5e-11, (err_sweep, err_row)  # measured 1.4, 2.2e-11
+    # rows with an integrand of their own, alone in a batch (no run found: no sort), are
+    # the same numbers bit for bit
+    own = np.flatnonzero(perm >= p0.size - m)
+    alone = seal_leak_piezo(tables, **dict(kw, p0=p0[own], dp=dp[own], p_b=pb[own],
+                                           alpha_pv=al[own]))
+    np.testing.assert_array_equal(alone.Q.to_numpy(), got.Q.to_numpy()[own])
+    if law == "barus":
+        p = 5e4
+        for i in np.flatnonzero((p0 == p) & (pb == 0.0))[:3]:
+            q, _ = seal_bvp(_sigma(tables, "emt"), lambda xx: p + 0 * xx, 0.0, 5e-3, dp[i],
+                            0.0, 3e-5)
+            assert abs(got.Q[i] / (q * L_Y) - 1) < 1e-8
+
+
 @pytest.mark.parametrize("steps", [None, 200])  # panel collocation (default), shooting
 @pytest.mark.parametrize("theory", ["critical_junction", "emt"])
 def test_seal_hertz(tables, theory, steps):

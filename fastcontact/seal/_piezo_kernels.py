@@ -101,18 +101,22 @@ def _ln_eta(p, A, Z, pr):
 
 
 @njit(cache=True)
-def _uniform_integral(tab, sc, E, p0, pa, pb, A, Z, pr, quad):
-    """∫_{p_b}^{p_a} σ̄(p0 - p) η0/η(p - p_b) dp [Pa], in x = ln((p0 - p)/E*); the viscosity law
-    as in :func:`_ln_eta` (Barus: e^{-α(p - p_b)}); ``quad`` the composite rule (:class:`Quad`)."""
-    glx, glw, width = quad.x, quad.w, quad.width
+def _x_ends(sc, E, p0, pa, pb):
+    """(x_a, x_b): the uniform-ring integral's ends in x = ln(p_cont/E*) (p_cont = p0 - p at
+    the inlet and the outlet); the inlet end at most TAIL_CUT below the table's bottom."""
     xb = math.log((p0 - pb) / E)
     if pa >= p0:
-        xa = sc[0].x_lo - TAIL_CUT
-    else:
-        xa = math.log((p0 - pa) / E)
-        xa = max(xa, sc[0].x_lo - TAIL_CUT)
+        return sc[0].x_lo - TAIL_CUT, xb
+    return max(math.log((p0 - pa) / E), sc[0].x_lo - TAIL_CUT), xb
+
+
+@njit(cache=True)
+def _panels(tab, sc, E, p0, pb, A, Z, pr, quad, xa, xb):
+    """∫_{xa}^{xb} σ̄ p_c η0/η dx by the composite rule: equal panels no wider than quad.width,
+    Gauss–Legendre on each (0 if xb <= xa)."""
     if not xb > xa:
         return 0.0
+    glx, glw, width = quad.x, quad.w, quad.width
     m = max(1, int(math.ceil((xb - xa) / width)))
     hw = (xb - xa) / m
     s = 0.0
@@ -126,13 +130,50 @@ def _uniform_integral(tab, sc, E, p0, pa, pb, A, Z, pr, quad):
     return s
 
 
+@njit(cache=True)
+def _uniform_integral(tab, sc, E, p0, pa, pb, A, Z, pr, quad):
+    """∫_{p_b}^{p_a} σ̄(p0 - p) η0/η(p - p_b) dp [Pa], in x = ln((p0 - p)/E*); the viscosity law
+    as in :func:`_ln_eta` (Barus: e^{-α(p - p_b)}); ``quad`` the composite rule (:class:`Quad`)."""
+    xa, xb = _x_ends(sc, E, p0, pa, pb)
+    return _panels(tab, sc, E, p0, pb, A, Z, pr, quad, xa, xb)
+
+
 @njit(parallel=True, cache=True)
 def _uniform_kernel(tab, sc, rows, pr, quad, out):
     """q = (1/L) ∫ σ̄ η0/η dp of each ring (:class:`UniformRows`; pr = 0: Barus with A = α,
-    Z unused)."""
+    Z unused), every row's integral on its own: the reference of
+    :func:`_uniform_sweep_kernel`."""
     for i in prange(rows.p0.size):
         out[i] = _uniform_integral(tab, sc, rows.E[i], rows.p0[i], rows.pa[i], rows.pb[i],
                                    rows.A[i], rows.Z[i], pr, quad) / rows.L[i]
+
+
+@njit(parallel=True, cache=True)
+def _uniform_sweep_kernel(tab, sc, rows, pr, quad, short, starts, out):
+    """:func:`_uniform_kernel` for rows sorted into runs that share E*, p0, p_b, A and Z (the
+    integrand), each run in ascending p_a; ``starts`` the first row of each chunk of a run
+    (and the row count last). A chunk integrates its first row from the outlet end x_b, then
+    each next row only over [x_a, previous x_a] (its integral is the previous one plus that
+    piece): a Δp sweep costs a panel or two per row instead of the whole range. A piece no
+    wider than ``short.width`` takes the short rule ``short`` (fewer Gauss points)."""
+    for c in prange(starts.size - 1):
+        i0 = starts[c]
+        E = rows.E[i0]  # one per statement (parfor lowering and tuple unpacking)
+        p0 = rows.p0[i0]
+        pb = rows.pb[i0]
+        A = rows.A[i0]
+        Z = rows.Z[i0]
+        acc = 0.0
+        x_hi = math.inf
+        for i in range(i0, starts[c + 1]):
+            xa, xb = _x_ends(sc, E, p0, rows.pa[i], pb)
+            if x_hi == math.inf:
+                x_hi = xb
+            if xa < x_hi:
+                rule = short if x_hi - xa <= short.width else quad
+                acc += _panels(tab, sc, E, p0, pb, A, Z, pr, rule, xa, x_hi)
+                x_hi = xa
+            out[i] = acc / rows.L[i]
 
 
 @njit(cache=True)

@@ -49,7 +49,7 @@ from ..kernels.records import scalar_record
 from . import _panels
 from .context import NEAR_LIFT_OFF, seal_context, solve_profile_rows, solver_options
 from ._piezo_kernels import (TAIL_CUT, HertzRows, Quad, UniformRows, _hertz_kernel,
-                             _hertz_kernel_r, _uniform_kernel)
+                             _hertz_kernel_r, _uniform_sweep_kernel)
 
 __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
 
@@ -124,7 +124,10 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
     profile : {"uniform", "hertz"}
         Flat ring (needs ``p0`` [Pa], ``L`` [m]) or O-ring (needs ``R`` [m], ``f_N`` [N/m]).
     quad_order, quad_width : int, float
-        Gauss–Legendre order and panel width in ln p_cont (uniform ring).
+        Gauss–Legendre order and panel width in ln p_cont (uniform ring). Rings that share
+        p0, p_b, E* and the viscosity law (a Δp sweep of one seal) are integrated in order of
+        p_a, each as the previous one's integral plus the piece between their inlet ends
+        (pieces no wider than SHORT_WIDTH × quad_width with SHORT_ORDER points).
     steps : int or None
         RK4 steps of the O-ring shooting across the Hertz sealing zone. None (default): the
         Barus O-ring by the base engine's panel collocation in ψ (~4× faster than 200 steps;
@@ -230,6 +233,55 @@ def _roelands_law(v, roelands_z, roelands_p_r, roelands_eta_inf):
             pr)
 
 
+#: rows per chunk of a run of :func:`_uniform_sweep_kernel` (each chunk integrates its first
+#: row over the whole range: ~1.5 µs, shared by its rows)
+SWEEP_CHUNK = 256
+#: a sweep's piece no wider than SHORT_WIDTH × quad_width (in ln p_cont) takes SHORT_ORDER
+#: Gauss points instead of quad_order (its error, ∝ width^(2n), is far below the full rule's)
+SHORT_WIDTH = 0.04
+SHORT_ORDER = 4
+
+
+def _shares(keys, n, sample=2048):
+    """Whether rows seem to share an integrand: any two of ~``sample`` evenly spaced rows with
+    equal keys (a cheap guess that spares a batch of distinct rings the sort; a miss only
+    costs speed)."""
+    smp = [k[::max(1, n // sample)] for k in keys]
+    o = np.lexsort(smp[::-1])
+    same = np.ones(o.size - 1, dtype=bool)
+    for k in smp:
+        ks = k[o]
+        same &= ks[1:] == ks[:-1]
+    return bool(same.any())
+
+
+def _sweep_order(sub):
+    """(order, starts) for :func:`_uniform_sweep_kernel`: the rows (p0, L, p_a, p_b, E*, A, Z)
+    sorted into runs sharing E*, p0, p_b, A, Z (the integrand), ascending p_a within a run, and
+    the first row of each chunk (a run cut every SWEEP_CHUNK rows; the row count last). order
+    None: the rows as they are, each its own run (:func:`_shares` found no shared one)."""
+    p0, _L, pa, pb, E, A, Z = sub
+    keys = [k for k in (E, p0, pb, A, Z) if k.min() != k.max()]  # the ones that vary
+    n = pa.size
+    if keys and not _shares(keys, n):  # every row its own integrand: rows as they are
+        return None, np.arange(n + 1, dtype=np.int64)
+    new_run = np.zeros(n, dtype=bool)
+    if not keys:  # one run (a Δp sweep of one seal)
+        order = np.argsort(pa, kind="stable")
+    else:
+        order = np.lexsort([pa] + keys[::-1])
+        for k in keys:
+            ks = k[order]
+            new_run[1:] |= ks[1:] != ks[:-1]
+    new_run[0] = True
+    first = np.flatnonzero(new_run)
+    # each run cut into chunks of SWEEP_CHUNK rows (they run in parallel)
+    run_id = np.cumsum(new_run) - 1
+    pos = np.arange(n) - first[run_id]
+    starts = np.flatnonzero(new_run | (pos % SWEEP_CHUNK == 0))
+    return order, np.append(starts, n).astype(np.int64)
+
+
 def _uniform_rows(tab, sc, v, law, quad_order, quad_width):
     """(columns, (k, converged, lift, percolated, out_of_table, p_max)) of flat rings; k =
     12 η0 q / h³ [Pa/m] by the uniform-ring integral of every running row."""
@@ -244,9 +296,13 @@ def _uniform_rows(tab, sc, v, law, quad_order, quad_width):
         out = np.empty(int(run.sum()))
         A, Z, pr = law if law is not None else (v["alpha_pv"], np.zeros(E.size), 0.0)
         sub = [np.ascontiguousarray(a[run], dtype=np.float64) for a in (p0v, Lv, pa, pb, E, A, Z)]
-        _uniform_kernel(tab, sc, UniformRows(*sub), float(pr), Quad(x, w, float(quad_width)),
-                        out)
-        kq[run] = out
+        order, starts = _sweep_order(sub)
+        rows = UniformRows(*(sub if order is None else
+                             (np.ascontiguousarray(a[order]) for a in sub)))
+        xs, ws = gauss_legendre(SHORT_ORDER)
+        _uniform_sweep_kernel(tab, sc, rows, float(pr), Quad(x, w, float(quad_width)),
+                              Quad(xs, ws, SHORT_WIDTH * float(quad_width)), starts, out)
+        kq[run if order is None else np.flatnonzero(run)[order]] = out
     cols = _base_columns(v)
     cols.update({"p0": p0v, "L": Lv, "open_inlet": np.where(pa > p0v, Lv, 0.0),
                  "open_outlet": np.zeros_like(Lv)})
