@@ -164,11 +164,9 @@ def _uniform_sweep_kernel(tab, sc, rows, pr, quad, short, starts, out):
         A = rows.A[i0]
         Z = rows.Z[i0]
         acc = 0.0
-        x_hi = math.inf
+        x_hi = _x_ends(sc, E, p0, rows.pa[i0], pb)[1]  # the outlet end, shared by the run
         for i in range(i0, starts[c + 1]):
-            xa, xb = _x_ends(sc, E, p0, rows.pa[i], pb)
-            if x_hi == math.inf:
-                x_hi = xb
+            xa = _x_ends(sc, E, p0, rows.pa[i], pb)[0]
             if xa < x_hi:
                 rule = short if x_hi - xa <= short.width else quad
                 acc += _panels(tab, sc, E, p0, pb, A, Z, pr, rule, xa, x_hi)

@@ -242,17 +242,23 @@ SHORT_WIDTH = 0.04
 SHORT_ORDER = 4
 
 
+def _new_runs(keys, order):
+    """For the rows in ``order`` (sorted by the keys): True where a row's keys differ from the
+    previous row's (and at the first row)."""
+    new = np.zeros(order.size, dtype=bool)
+    new[0] = True
+    for k in keys:
+        ks = k[order]
+        new[1:] |= ks[1:] != ks[:-1]
+    return new
+
+
 def _shares(keys, n, sample=2048):
     """Whether rows seem to share an integrand: any two of ~``sample`` evenly spaced rows with
     equal keys (a cheap guess that spares a batch of distinct rings the sort; a miss only
     costs speed)."""
     smp = [k[::max(1, n // sample)] for k in keys]
-    o = np.lexsort(smp[::-1])
-    same = np.ones(o.size - 1, dtype=bool)
-    for k in smp:
-        ks = k[o]
-        same &= ks[1:] == ks[:-1]
-    return bool(same.any())
+    return not _new_runs(smp, np.lexsort(smp[::-1])).all()
 
 
 def _sweep_order(sub):
@@ -265,15 +271,9 @@ def _sweep_order(sub):
     n = pa.size
     if keys and not _shares(keys, n):  # every row its own integrand: rows as they are
         return None, np.arange(n + 1, dtype=np.int64)
-    new_run = np.zeros(n, dtype=bool)
-    if not keys:  # one run (a Δp sweep of one seal)
-        order = np.argsort(pa, kind="stable")
-    else:
-        order = np.lexsort([pa] + keys[::-1])
-        for k in keys:
-            ks = k[order]
-            new_run[1:] |= ks[1:] != ks[:-1]
-    new_run[0] = True
+    # one run (a Δp sweep of one seal) if no key varies
+    order = np.lexsort([pa] + keys[::-1]) if keys else np.argsort(pa, kind="stable")
+    new_run = _new_runs(keys, order)
     first = np.flatnonzero(new_run)
     # each run cut into chunks of SWEEP_CHUNK rows (they run in parallel)
     run_id = np.cumsum(new_run) - 1

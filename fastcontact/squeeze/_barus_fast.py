@@ -19,7 +19,8 @@ from ..kernels.borrow import borrowed
 from ._barus_primitive import BarusTable, s_value, series_order, shift, u_at_time
 from ._fastpath import ZTargets, _target_time, row_targets
 from ._kernels import Cases, Quad
-from ._primitive_eval import Primitive, inverse_constants, row_value, stencil, t_of_z
+from ._primitive_eval import (Primitive, inverse_constants, one_plus_exp, row_value, stencil,
+                              t_of_z)
 from .tire_piezo import _BELOW as TIRE_BELOW
 from .tire_piezo import _OK as TIRE_OK
 from .tire_piezo import TireOut, _tire_case
@@ -55,7 +56,7 @@ def _start(pr, bt, st, E, K, x0, vs_in, lnTs):
     vinf = math.exp(row_value(pr.lnv, st))
     if vs_in != vs_in:
         zs = row_value(pr.zs, st)
-        vs = vinf * (1.0 + math.exp(zs))
+        vs = vinf * one_plus_exp(zs)
         Ts = -1.0
         Ts_row = math.exp(row_value(lnTs, st))
     else:

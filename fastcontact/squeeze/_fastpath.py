@@ -95,7 +95,7 @@ def _start(pr, st, vinf, vs_in):
     """(v_start, T(v_start)) of a case: the default start (NaN in) or the given one."""
     if vs_in != vs_in:
         zs = row_value(pr.zs, st)
-        vs = vinf * (1.0 + math.exp(zs))
+        vs = vinf * one_plus_exp(zs)
     else:
         vs = vs_in
         if vs == math.inf:
@@ -159,7 +159,7 @@ def _case_start(pr, st, vinf, vs_in, rt):
     least GUARD_Z below the start only), else from t_of_z."""
     if vs_in != vs_in:
         zs = row_value(pr.zs, st)
-        return zs, vinf * (1.0 + math.exp(zs)), -1.0, math.exp(row_value(rt.lnTs, st))
+        return zs, vinf * one_plus_exp(zs), -1.0, math.exp(row_value(rt.lnTs, st))
     if vs_in == math.inf:
         return math.inf, vs_in, 0.0, 0.0
     zs = math.log(vs_in / vinf - 1.0)

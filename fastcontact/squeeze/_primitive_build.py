@@ -18,8 +18,8 @@ from numba import njit, prange
 from ..kernels.hermite import cubic_basis
 from ..kernels.quadrature import gauss_legendre
 from . import _kernels as qk
-from ._primitive_eval import (Primitive, _index_map, lagrange_denominators, row_value, stencil,
-                              t_of_z)
+from ._primitive_eval import (Primitive, _index_map, lagrange_denominators, one_plus_exp,
+                              row_value, stencil, t_of_z)
 
 __all__ = ["build", "measure_error", "profile", "fast_limit", "Profile", "DXI", "Z_LO", "DZ",
            "NODE_ORDER", "X_END", "X_FALLBACK"]
@@ -170,7 +170,7 @@ def _build_row(pf, mp, x0, vinf, lk, z0, dz, glx, glw, C, j):
     for k in range(nz - 1, -1, -1):
         z = z0 + k * dz - lk
         if z >= z_ext:
-            T = qk._tail_int(mp.c, vinf * (1.0 + math.exp(z)) + mp.d, math.inf)
+            T = qk._tail_int(mp.c, vinf * one_plus_exp(z) + mp.d, math.inf)
         else:
             T = T_prev + _panel(pf, mp, x0, vinf, z, z_prev, glx, glw)
             z_prev = z
@@ -230,7 +230,7 @@ def _check_kernel(pf, mp, pr, xm, zm, glx, glw, err):
         vinf = math.exp(_plnv(pf, mp, x0))
         st = stencil(pr, x0)
         z = zm[i] - row_value(pr.lk, st)
-        v = vinf * (1.0 + math.exp(z))
+        v = vinf * one_plus_exp(z)
         z_ext = math.log(mp.v_ext / vinf - 1.0)
         if z >= z_ext:
             T = qk._tail_int(mp.c, v + mp.d, math.inf)
