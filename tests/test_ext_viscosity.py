@@ -267,6 +267,76 @@ def test_seal_uniform_sweep_matches_per_row(tables, law):
             assert abs(got.Q[i] / (q * L_Y) - 1) < 1e-8
 
 
+@pytest.mark.parametrize("theory", ["emt", "critical_junction"])
+def test_seal_barus_cells_match_per_row(tables, theory):
+    """Barus flat rings of distinct p0 that share α E* take the cumulative table (whole cells
+    from prefix/suffix sums, the two partial cells by 3 Gauss points): equal to every row's
+    own integral with 10x narrower panels and 16 Gauss points to 5e-11 (measured ~1e-12),
+    including Δp within one cell, inlets at the tail cut, rings next to percolation and rows
+    of a rarer α (the per-row path); a few rows equal the separate BVP reference to 1e-8; a
+    group whose weight e^{α p_cont} would span more than e^200 keeps the per-row path."""
+    from fastcontact.kernels.quadrature import gauss_legendre
+    from fastcontact.seal._piezo_kernels import Quad, UniformRows, _uniform_kernel
+    import fastcontact.seal.viscosity as sv
+
+    rng = np.random.default_rng(7)
+    n = sv.BARUS_TABLE_ROWS + 500
+    p_perc = float(tables.info["percolation_p_over_E"][theory]) * E_STAR
+    p0 = np.exp(rng.uniform(math.log(2e3), math.log(0.999 * p_perc), n))
+    pb = rng.uniform(0.0, 1e3, n) * (p0 > 1e4)
+    frac = np.where(rng.random(n) < 0.3, 10 ** rng.uniform(-9, -4, n), rng.uniform(1e-3, 1.0, n))
+    dp = (p0 - pb) * frac
+    dp[:40] = (p0[:40] - pb[:40]) * (1 - 1e-12)  # inlet contact pressure near 0: the tail cut
+    al = np.full(n, 2e-6)
+    al[-300:] = rng.uniform(1e-6, 4e-6, 300)  # rows of their own α: the per-row path
+    kw = dict(p0=p0, dp=dp, p_b=pb, L=5e-3, L_y=L_Y, E_star=E_STAR, eta=ETA, alpha_pv=al,
+              theory=theory)
+    calls = []
+    real = sv._barus_cells_rows
+
+    def spy(tab, sc, rows, bc, short, out):
+        real(tab, sc, rows, bc, short, out)
+        calls.append(dict(tab=tab, sc=sc, rows=rows, out=out.copy()))
+
+    sv._barus_cells_rows = spy
+    try:
+        got = seal_leak_piezo(tables, **kw)
+    finally:
+        sv._barus_cells_rows = real
+    assert (got.status == "ok").all()
+    assert len(calls) == 1 and calls[0]["rows"].p0.size >= n - 300  # the shared α's rows
+    c = calls[0]
+    x, w = gauss_legendre(16)
+    ref = np.empty(c["out"].size)
+    _uniform_kernel(c["tab"], c["sc"], c["rows"], 0.0, Quad(x, w, 0.05), ref)
+    assert np.all(ref > 0)
+    err = np.max(np.abs(c["out"] / ref - 1))
+    assert err < 5e-11, err
+    # the whole batch (table rows and per-row rows) against the same reference, through Q
+    # (every row back in its place); the per-row default rule (panels 0.5 wide, not split at
+    # the σ̄ table's nodes) is off by up to ~2e-8 next to percolation (measured 1.9e-8)
+    sub = UniformRows(*(np.ascontiguousarray(a, dtype=np.float64) for a in (
+        p0, np.full(n, 5e-3), pb + dp, pb, np.full(n, E_STAR), al, np.zeros(n))))
+    ref_all = np.empty(n)
+    _uniform_kernel(c["tab"], c["sc"], sub, 0.0, Quad(x, w, 0.05), ref_all)
+    q_ref = L_Y * ref_all * float(tables.h_rms) ** 3 / (12.0 * ETA)
+    np.testing.assert_allclose(got.Q.to_numpy(), q_ref, rtol=5e-8, atol=0)
+    for i in np.flatnonzero((frac > 0.1) & (p0 < 0.3 * p_perc))[40:43]:  # separate BVP
+        p = p0[i]
+        q, _ = seal_bvp(_sigma(tables, theory), lambda xx: p + 0 * xx, 0.0, 5e-3, pb[i] + dp[i],
+                        pb[i], al[i])
+        assert abs(got.Q[i] / (q * L_Y) - 1) < 1e-8
+    # weights beyond e^200 over the table: the per-row path, same numbers
+    big = dict(kw, alpha_pv=np.full(n, 1e-4))
+    calls.clear()
+    sv._barus_cells_rows = spy
+    try:
+        got_big = seal_leak_piezo(tables, **big)
+    finally:
+        sv._barus_cells_rows = real
+    assert not calls and (got_big.status == "ok").all() and np.all(got_big.Q > 0)
+
+
 @pytest.mark.parametrize("steps", [None, 200])  # panel collocation (default), shooting
 @pytest.mark.parametrize("theory", ["critical_junction", "emt"])
 def test_seal_hertz(tables, theory, steps):

@@ -18,9 +18,10 @@ import numpy as np
 from numba import njit, prange
 
 from ..flow.piezoviscosity import ln_roelands
+from ..kernels.locate import locate_asc
 from ..tables import k_sigma_of_lnp
 
-__all__ = ["TAIL_CUT", "Quad", "UniformRows", "HertzRows", "HertzCase"]
+__all__ = ["TAIL_CUT", "Quad", "UniformRows", "HertzRows", "HertzCase", "BarusCells"]
 
 #: the uniform-ring quadrature starts TAIL_CUT below ln(p_cont_min/E*) of the table (integrand ∝ p_cont)
 TAIL_CUT = 60.0
@@ -46,6 +47,20 @@ class UniformRows(NamedTuple):
     E: np.ndarray
     A: np.ndarray
     Z: np.ndarray
+
+
+class BarusCells(NamedTuple):
+    """The Barus flat ring's cumulative table for one β = α E* (:func:`_barus_cells_kernel`):
+    uniform cells of width ``w`` in x = ln(p_cont/E*) from ``x0``, ``top`` = e^{x_top} (the
+    table's upper end), prefix sums ``pre`` (pre[c] = Σ of cells below c) and suffix sums
+    ``suf`` (suf[c] = Σ of cells c and above) of ∫ σ̄ e^x e^{β(e^x - top)} dx over each cell."""
+
+    x0: float
+    w: float
+    top: float
+    beta: float
+    pre: np.ndarray
+    suf: np.ndarray
 
 
 class HertzRows(NamedTuple):
@@ -172,6 +187,87 @@ def _uniform_sweep_kernel(tab, sc, rows, pr, quad, short, starts, out):
                 acc += _panels(tab, sc, E, p0, pb, A, Z, pr, rule, xa, x_hi)
                 x_hi = xa
             out[i] = acc / rows.L[i]
+
+
+@njit(cache=True, inline="always")
+def _barus_gl(tab, sc, beta, top, quad, a, b):
+    """∫_a^b σ̄ e^x e^{β(e^x - top)} dx, one Gauss–Legendre panel (``quad``'s points)."""
+    half = 0.5 * (b - a)
+    mid = a + half
+    s = 0.0
+    for j in range(quad.x.size):
+        x = mid + half * quad.x[j]
+        ex = math.exp(x)
+        s += quad.w[j] * _sigma(tab, sc, x) * ex * math.exp(beta * (ex - top))
+    return half * s
+
+
+@njit(cache=True)
+def _barus_weighted(tab, sc, beta, top, quad, a, b):
+    """∫_a^b σ̄ e^x e^{β(e^x - top)} dx (a <= b), one Gauss–Legendre panel between each two
+    of the σ̄ table's nodes inside [a, b] (σ̄ is smooth between nodes only: next to
+    percolation ln σ̄ is linear across unresolved intervals, and the table's bottom joins
+    the ū³ tail)."""
+    lnp = tab.lnp
+    n = lnp.size
+    s = 0.0
+    lo = a
+    if b > lnp[0] and a < lnp[n - 1]:
+        k = 0 if a < lnp[0] else locate_asc(a, lnp, tab.bp_lo, tab.bp_dz, tab.bp_idx) + 1
+        while k < n and lnp[k] < b:
+            if lnp[k] > lo:
+                s += _barus_gl(tab, sc, beta, top, quad, lo, lnp[k])
+                lo = lnp[k]
+            k += 1
+    return s + _barus_gl(tab, sc, beta, top, quad, lo, b)
+
+
+@njit(parallel=True, cache=True)
+def _barus_cells_kernel(tab, sc, beta, x0, w, top, quad, cells):
+    """cells[c] = ∫ over [x0 + c w, x0 + (c + 1) w] of σ̄ e^x e^{β(e^x - top)} dx (the rule
+    ``quad`` on each cell, split at the σ̄ table's nodes)."""
+    for c in prange(cells.size):
+        a = x0 + c * w
+        cells[c] = _barus_weighted(tab, sc, beta, top, quad, a, a + w)
+
+
+@njit(cache=True, inline="always")
+def _cells_sum(bc, c0, c1):
+    """Σ of cells c0 .. c1 - 1 from the prefix or the suffix sums, whichever difference has
+    the smaller terms (less cancellation)."""
+    if c1 <= c0:
+        return 0.0
+    if bc.pre[c1] <= bc.suf[c0]:
+        return bc.pre[c1] - bc.pre[c0]
+    return bc.suf[c0] - bc.suf[c1]
+
+
+@njit(parallel=True, cache=True)
+def _barus_cells_rows(tab, sc, rows, bc, short, out):
+    """Barus flat rings (:class:`UniformRows`, all with α E* = bc.beta) from the cumulative
+    table ``bc`` (:class:`BarusCells`): q L = E* e^{β top - α(p0 - p_b)} ∫_{x_a}^{x_b}
+    σ̄ e^x e^{β(e^x - top)} dx, the whole cells between the ends from the table, the two
+    partial cells by the short rule ``short`` (split at the σ̄ table's nodes)."""
+    nc = bc.pre.size - 1
+    x0 = bc.x0
+    w = bc.w
+    for i in prange(rows.p0.size):
+        E = rows.E[i]
+        p0 = rows.p0[i]
+        pb = rows.pb[i]
+        xa, xb = _x_ends(sc, E, p0, rows.pa[i], pb)
+        if not xb > xa:
+            out[i] = 0.0
+            continue
+        ca = min(max(int((xa - x0) / w), 0), nc - 1)
+        cb = min(max(int((xb - x0) / w), 0), nc - 1)
+        if ca == cb:
+            s = _barus_weighted(tab, sc, bc.beta, bc.top, short, xa, xb)
+        else:
+            s = (_barus_weighted(tab, sc, bc.beta, bc.top, short, xa, x0 + (ca + 1) * w)
+                 + _cells_sum(bc, ca + 1, cb)
+                 + _barus_weighted(tab, sc, bc.beta, bc.top, short, x0 + cb * w, xb))
+        out[i] = E * math.exp(bc.beta * bc.top - rows.A[i] * (p0 - pb)) * s / rows.L[i]
 
 
 @njit(cache=True)

@@ -8,7 +8,12 @@ conductivity σ0 at the outlet viscosity η0 and the reduced pressure
 
 * **uniform ring** (p0 fixed): dp_f/dx = -q e^{α(p_f - p_b)}/σ0(p0 - p_f) separates, and
   ``q L = ∫_{p_b}^{p_a} σ0(p0 - p) e^{-α(p - p_b)} dp`` exactly (α = 0: the paper's result
-  ``q = (1/L)∫σ_eff dp``). Evaluated by Gauss–Legendre in ln p_cont on the tables.
+  ``q = (1/L)∫σ_eff dp``). Evaluated by Gauss–Legendre in ln p_cont on the tables. In
+  x = ln(p_cont/E*) it is q L = E* e^{-α(p0 - p_b)} ∫_{x_a}^{x_b} σ̄ e^x e^{αE* e^x} dx: the
+  weight does not depend on p0, so rings sharing α E* (but not p0) read one cumulative table
+  of that integral per call (cells of 0.01 in x, prefix and suffix sums) and integrate only
+  the two partial cells at their ends (:func:`_barus_cells`); rings sharing the whole
+  integrand (a Δp sweep) add each row's piece to the previous row's integral.
 * **Hertz O-ring** (p0(x) = p_H √(1 - ((x-a)/a)²)): dψ/dx = -q/σ0(p0(x) - p_f(ψ)) has no
   closed form. Integrated from the outlet, ψ(x) = q ∫_x^{x_e} dx'/σ0, so with
   W = ∫_{x_s}^{x_e} dx/σ0 over the sealing zone p0(x) >= p_f, q = ψ_a/W and
@@ -48,7 +53,8 @@ from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from . import _panels
 from .context import NEAR_LIFT_OFF, seal_context, solve_profile_rows, solver_options
-from ._piezo_kernels import (TAIL_CUT, HertzRows, Quad, UniformRows, _hertz_kernel,
+from ._piezo_kernels import (TAIL_CUT, BarusCells, HertzRows, Quad, UniformRows,
+                             _barus_cells_kernel, _barus_cells_rows, _hertz_kernel,
                              _hertz_kernel_r, _uniform_sweep_kernel)
 
 __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
@@ -174,8 +180,12 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
     Q = scale * v["L_y"] * kq * float(tables.h_rms) ** 3 / (12.0 * v["eta"])
     Q = np.where(lift, math.inf, np.where(conv & ~out_t, Q, math.nan))
     # a NaN row says why before the lift-off equality's flag (its Q is finite when solved)
-    status = np.select([lift, out_t, perc, ~conv, v["pa"] == pmax],
-                       ["open", "above_table", "percolated", "not_converged", "lift_off"], "ok")
+    from .api import STATUS  # the seal engine's status names (api imports this module)
+    codes = np.select([lift, out_t, perc, ~conv, v["pa"] == pmax],
+                      [STATUS.index(s) for s in ("open", "above_table", "percolated",
+                                                 "not_converged", "lift_off")],
+                      STATUS.index("ok")).astype(np.int8)
+    status = pd.Categorical.from_codes(codes, categories=list(STATUS))
     cols.update({"p_a": v["pa"], "Q": Q, "lift_off": lift | (v["pa"] == pmax),
                  "percolated": perc, "converged": conv, "out_of_table": out_t, "status": status})
     return _piezo_frame(cols, law, theory, profile, shape, roelands_eta_inf)
@@ -242,6 +252,80 @@ SHORT_WIDTH = 0.04
 SHORT_ORDER = 4
 
 
+#: Barus flat rings sharing β = α E* in groups of at least BARUS_TABLE_ROWS rows take a
+#: cumulative table of ∫ σ̄ e^x e^{β(e^x - top)} dx (:func:`_barus_cells`): cells of
+#: BARUS_CELL_WIDTH in x = ln(p_cont/E*), each by the full rule; a row then costs the two
+#: partial cells at its ends by BARUS_SHORT_ORDER Gauss points (Barus separates exactly:
+#: q L η0 = E* e^{-α(p0 - p_b)} ∫ σ̄ e^x e^{β e^x} dx); β·e^{x_top} above BARUS_BETA_TOP_MAX
+#: (weights below e^-200 at the table's bottom) keeps the per-row integral
+BARUS_CELL_WIDTH = 0.01
+BARUS_SHORT_ORDER = 4
+BARUS_TABLE_ROWS = 2048
+BARUS_BETA_TOP_MAX = 200.0
+
+
+def _barus_cells(tab, sc, beta, quad):
+    """The :class:`BarusCells` of β = α E* [-] on the flat ring's range of x = ln(p_cont/E*):
+    from TAIL_CUT below the tables' bottom to the top (or percolation), each cell by the
+    rule ``quad`` (the per-row integral's)."""
+    s = sc[0]
+    x0 = float(s["x_lo"]) - TAIL_CUT
+    x1 = min(float(s["x_hi"]), float(s["x_perc"]))
+    nc = int(math.ceil((x1 - x0) / BARUS_CELL_WIDTH))
+    w = (x1 - x0) / nc
+    top = math.exp(x1)
+    cells = np.empty(nc)
+    _barus_cells_kernel(tab, sc, float(beta), x0, w, top, quad, cells)
+    pre = np.concatenate(([0.0], np.cumsum(cells)))
+    suf = np.concatenate((np.cumsum(cells[::-1])[::-1], [0.0]))
+    return BarusCells(x0, w, top, float(beta), pre, suf)
+
+
+def _barus_groups(beta, top):
+    """[(β, rows)] of the Barus flat rings that take a cumulative table: groups of at least
+    BARUS_TABLE_ROWS rows sharing β = α E* with β·top <= BARUS_BETA_TOP_MAX (rows None: all
+    of them)."""
+    n = beta.size
+    if n < BARUS_TABLE_ROWS:
+        return []
+    if beta.min() == beta.max():
+        return [(float(beta[0]), None)] if beta[0] * top <= BARUS_BETA_TOP_MAX else []
+    if not _shares([beta], n):
+        return []
+    u, inv, cnt = np.unique(beta, return_inverse=True, return_counts=True)
+    return [(float(u[g]), np.flatnonzero(inv == g)) for g in np.flatnonzero(
+        (cnt >= BARUS_TABLE_ROWS) & (u * top <= BARUS_BETA_TOP_MAX))]
+
+
+def _barus_tabled(tab, sc, sub, quad, out):
+    """Fill ``out`` for the Barus flat rings (columns ``sub`` as in :func:`_uniform_rows`) that
+    take a cumulative table (:func:`_barus_groups`); returns the mask of rows filled. Batches
+    with runs of a shared integrand (Δp sweeps of one seal) keep the sweep kernel: a row there
+    costs a piece between two inlet ends, cheaper than the two partial cells here."""
+    done = np.zeros(out.size, dtype=bool)
+    p0, _L, _pa, pb, E, A, _Z = sub
+    keys = [k for k in (E, p0, pb, A) if k.min() != k.max()]
+    if not keys or _shares(keys, out.size):  # Δp sweeps: the sweep kernel is faster
+        return done
+    top = math.exp(min(float(sc[0]["x_hi"]), float(sc[0]["x_perc"])))
+    groups = _barus_groups(A * E, top)
+    if groups:
+        xs, ws = gauss_legendre(BARUS_SHORT_ORDER)
+        short = Quad(xs, ws, BARUS_CELL_WIDTH)
+    for beta, idx in groups:
+        bc = _barus_cells(tab, sc, beta, quad)
+        if idx is None:
+            _barus_cells_rows(tab, sc, UniformRows(*sub), bc, short, out)
+            done[:] = True
+        else:
+            o = np.empty(idx.size)
+            _barus_cells_rows(tab, sc, UniformRows(*(np.ascontiguousarray(a[idx]) for a in sub)),
+                              bc, short, o)
+            out[idx] = o
+            done[idx] = True
+    return done
+
+
 def _new_runs(keys, order):
     """For the rows in ``order`` (sorted by the keys): True where a row's keys differ from the
     previous row's (and at the first row)."""
@@ -296,13 +380,21 @@ def _uniform_rows(tab, sc, v, law, quad_order, quad_width):
         out = np.empty(int(run.sum()))
         A, Z, pr = law if law is not None else (v["alpha_pv"], np.zeros(E.size), 0.0)
         sub = [np.ascontiguousarray(a[run], dtype=np.float64) for a in (p0v, Lv, pa, pb, E, A, Z)]
-        order, starts = _sweep_order(sub)
-        rows = UniformRows(*(sub if order is None else
-                             (np.ascontiguousarray(a[order]) for a in sub)))
-        xs, ws = gauss_legendre(SHORT_ORDER)
-        _uniform_sweep_kernel(tab, sc, rows, float(pr), Quad(x, w, float(quad_width)),
-                              Quad(xs, ws, SHORT_WIDTH * float(quad_width)), starts, out)
-        kq[run if order is None else np.flatnonzero(run)[order]] = out
+        quad = Quad(x, w, float(quad_width))
+        done = _barus_tabled(tab, sc, sub, quad, out) if law is None else np.zeros(out.size, bool)
+        rest = np.flatnonzero(~done)
+        if rest.size:
+            if rest.size < out.size:
+                sub = [np.ascontiguousarray(a[rest]) for a in sub]
+            order, starts = _sweep_order(sub)
+            rows = UniformRows(*(sub if order is None else
+                                 (np.ascontiguousarray(a[order]) for a in sub)))
+            xs, ws = gauss_legendre(SHORT_ORDER)
+            o = np.empty(rest.size)
+            _uniform_sweep_kernel(tab, sc, rows, float(pr), quad,
+                                  Quad(xs, ws, SHORT_WIDTH * float(quad_width)), starts, o)
+            out[rest if order is None else rest[order]] = o
+        kq[run] = out
     cols = _base_columns(v)
     cols.update({"p0": p0v, "L": Lv, "open_inlet": np.where(pa > p0v, Lv, 0.0),
                  "open_outlet": np.zeros_like(Lv)})
