@@ -270,11 +270,13 @@ def test_seal_uniform_sweep_matches_per_row(tables, law):
 @pytest.mark.parametrize("theory", ["emt", "critical_junction"])
 def test_seal_barus_cells_match_per_row(tables, theory):
     """Barus flat rings of distinct p0 that share α E* take the cumulative table (whole cells
-    from prefix/suffix sums, the two partial cells by 3 Gauss points): equal to every row's
-    own integral with 10x narrower panels and 16 Gauss points to 5e-11 (measured ~1e-12),
-    including Δp within one cell, inlets at the tail cut, rings next to percolation and rows
-    of a rarer α (the per-row path); a few rows equal the separate BVP reference to 1e-8; a
-    group whose weight e^{α p_cont} would span more than e^200 keeps the per-row path."""
+    from prefix/suffix sums, the two partial cells from the cell's Legendre series, or by
+    Gauss points where a σ̄ node lies inside the cell): equal to every row's own integral
+    with 10x narrower panels and 16 Gauss points to 5e-11 (measured 2.1e-11 next to
+    percolation, ~1e-12 elsewhere), including Δp within one cell, inlets at the tail cut,
+    rings next to percolation and rows of a rarer α (the per-row path); a long Δp sweep takes
+    the table too; a few rows equal the separate BVP reference to 1e-8; a group whose weight
+    e^{α p_cont} would span more than e^200 keeps the per-row path."""
     from fastcontact.kernels.quadrature import gauss_legendre
     from fastcontact.seal._piezo_kernels import Quad, UniformRows, _uniform_kernel
     import fastcontact.seal.viscosity as sv
@@ -296,7 +298,7 @@ def test_seal_barus_cells_match_per_row(tables, theory):
 
     def spy(tab, sc, rows, bc, short, out):
         real(tab, sc, rows, bc, short, out)
-        calls.append(dict(tab=tab, sc=sc, rows=rows, out=out.copy()))
+        calls.append(dict(tab=tab, sc=sc, rows=rows, out=out.copy(), bc=bc))
 
     sv._barus_cells_rows = spy
     try:
@@ -306,12 +308,32 @@ def test_seal_barus_cells_match_per_row(tables, theory):
     assert (got.status == "ok").all()
     assert len(calls) == 1 and calls[0]["rows"].p0.size >= n - 300  # the shared α's rows
     c = calls[0]
+    assert c["bc"].ok.mean() > 0.8  # most partial cells are Legendre sums
     x, w = gauss_legendre(16)
     ref = np.empty(c["out"].size)
     _uniform_kernel(c["tab"], c["sc"], c["rows"], 0.0, Quad(x, w, 0.05), ref)
     assert np.all(ref > 0)
     err = np.max(np.abs(c["out"] / ref - 1))
     assert err < 5e-11, err
+    # a Δp sweep of one ring long enough for the table (every 97th row checked)
+    m = sv.BARUS_TABLE_SWEEP_ROWS
+    p_s = 0.5 * p_perc
+    dps = p_s * np.sort(np.concatenate([10 ** rng.uniform(-9, -3, m // 4),
+                                        rng.uniform(1e-3, 0.999, m - m // 4)]))
+    calls.clear()
+    sv._barus_cells_rows = spy
+    try:
+        sweep = seal_leak_piezo(tables, **dict(kw, p0=p_s, dp=dps, p_b=0.0, alpha_pv=2e-6))
+    finally:
+        sv._barus_cells_rows = real
+    assert len(calls) == 1 and calls[0]["rows"].p0.size == m
+    pick = np.arange(0, m, 97)
+    rows_s = UniformRows(*(np.ascontiguousarray(a[pick]) for a in calls[0]["rows"]))
+    ref_s = np.empty(pick.size)
+    _uniform_kernel(c["tab"], c["sc"], rows_s, 0.0, Quad(x, w, 0.05), ref_s)
+    err_s = np.max(np.abs(calls[0]["out"][pick] / ref_s - 1))
+    assert err_s < 5e-11, err_s
+    assert np.all(np.diff(sweep.Q.to_numpy()) > 0)  # Q rises with Δp
     # the whole batch (table rows and per-row rows) against the same reference, through Q
     # (every row back in its place); the per-row default rule (panels 0.5 wide, not split at
     # the σ̄ table's nodes) is off by up to ~2e-8 next to percolation (measured 1.9e-8)

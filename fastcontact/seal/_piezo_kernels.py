@@ -51,16 +51,30 @@ class UniformRows(NamedTuple):
 
 class BarusCells(NamedTuple):
     """The Barus flat ring's cumulative table for one β = α E* (:func:`_barus_cells_kernel`):
-    uniform cells of width ``w`` in x = ln(p_cont/E*) from ``x0``, ``top`` = e^{x_top} (the
+    cells in x = ln(p_cont/E*), ``nt`` of width ``wt`` from ``x0`` up to ``xm`` (the ū³ tail
+    below the σ̄ table), then cells of width ``w`` from ``xm``; ``top`` = e^{x_top} (the
     table's upper end), prefix sums ``pre`` (pre[c] = Σ of cells below c) and suffix sums
-    ``suf`` (suf[c] = Σ of cells c and above) of ∫ σ̄ e^x e^{β(e^x - top)} dx over each cell."""
+    ``suf`` (suf[c] = Σ of cells c and above) of ∫ σ̄ e^x e^{β(e^x - top)} dx over each cell;
+    ``cells`` (nc) the cells' integrals; ``leg`` (nc, m): the integrand's Legendre coefficients
+    a_k on each cell (from its m Gauss points, u = 2(x - x_c)/w - 1), divided by 2k + 1 for
+    k >= 1; ``ra``, ``rb`` (m): (2k + 1)/(k + 1) and k/(k + 1); ``ok`` (nc): 1 where they
+    represent the integrand (no σ̄ table node inside the cell, the midpoint value verified), so
+    that a partial cell is a Legendre sum instead of new σ̄ evaluations."""
 
     x0: float
+    wt: float
+    nt: int
+    xm: float
     w: float
     top: float
     beta: float
     pre: np.ndarray
     suf: np.ndarray
+    cells: np.ndarray
+    leg: np.ndarray
+    ok: np.ndarray
+    ra: np.ndarray
+    rb: np.ndarray
 
 
 class HertzRows(NamedTuple):
@@ -222,13 +236,97 @@ def _barus_weighted(tab, sc, beta, top, quad, a, b):
     return s + _barus_gl(tab, sc, beta, top, quad, lo, b)
 
 
+#: a cell's Legendre series is trusted where it reproduces the integrand at the cell's
+#: midpoint to this relative tolerance (the series' error is largest there; ~1e-15 on cells
+#: where ln σ̄ is smooth and |d ln f/dx| w <= 0.3)
+LEGENDRE_MID_RTOL = 1e-12
+
+
+@njit(cache=True, inline="always")
+def _node_inside(tab, a, b):
+    """Whether a node of the σ̄ table lies strictly inside (a, b)."""
+    lnp = tab.lnp
+    n = lnp.size
+    if a < lnp[0]:
+        return lnp[0] < b
+    if a >= lnp[n - 1]:
+        return False
+    i = locate_asc(a, lnp, tab.bp_lo, tab.bp_dz, tab.bp_idx)
+    return i + 1 < n and a < lnp[i + 1] < b
+
+
+@njit(cache=True, inline="always")
+def _cell_of(bc, x):
+    """(c, start, width) of the cell of :class:`BarusCells` ``bc`` holding x (clamped)."""
+    if x < bc.xm:
+        c = min(max(int((x - bc.x0) / bc.wt), 0), bc.nt - 1)
+        return c, bc.x0 + c * bc.wt, bc.wt
+    c = min(int((x - bc.xm) / bc.w), bc.cells.size - bc.nt - 1)
+    return bc.nt + c, bc.xm + c * bc.w, bc.w
+
+
 @njit(parallel=True, cache=True)
-def _barus_cells_kernel(tab, sc, beta, x0, w, top, quad, cells):
-    """cells[c] = ∫ over [x0 + c w, x0 + (c + 1) w] of σ̄ e^x e^{β(e^x - top)} dx (the rule
-    ``quad`` on each cell, split at the σ̄ table's nodes)."""
+def _barus_cells_kernel(tab, sc, bc, quad, lt, pmid):
+    """bc.cells[c] = ∫ over cell c of σ̄ e^x e^{β(e^x - top)} dx (the rule
+    ``quad`` on each cell, split at the σ̄ table's nodes), the integrand's Legendre
+    coefficients bc.leg[c] from its values at the rule's points (``lt`` (m, m): a_k = Σ_j
+    lt[k, j] f_j) and bc.ok[c] (``pmid``: P_k(0), the midpoint check)."""
+    m = quad.x.size
+    cells = bc.cells
+    leg = bc.leg
+    ok = bc.ok
+    beta = bc.beta
+    top = bc.top
     for c in prange(cells.size):
-        a = x0 + c * w
-        cells[c] = _barus_weighted(tab, sc, beta, top, quad, a, a + w)
+        if c < bc.nt:
+            a = bc.x0 + c * bc.wt
+            w = bc.wt
+        else:
+            a = bc.xm + (c - bc.nt) * bc.w
+            w = bc.w
+        f = np.empty(m)
+        s = 0.0
+        for j in range(m):
+            x = a + 0.5 * w * (1.0 + quad.x[j])
+            ex = math.exp(x)
+            f[j] = _sigma(tab, sc, x) * ex * math.exp(beta * (ex - top))
+            s += quad.w[j] * f[j]
+        vm = 0.0
+        for k in range(m):
+            ak = 0.0
+            for j in range(m):
+                ak += lt[k, j] * f[j]
+            leg[c, k] = ak if k == 0 else ak / (2 * k + 1)
+            vm += ak * pmid[k]
+        if _node_inside(tab, a, a + w):
+            cells[c] = _barus_weighted(tab, sc, beta, top, quad, a, a + w)
+            ok[c] = 0.0
+        else:
+            cells[c] = 0.5 * w * s
+            xm = a + 0.5 * w
+            em = math.exp(xm)
+            fm = _sigma(tab, sc, xm) * em * math.exp(beta * (em - top))
+            ok[c] = 1.0 if abs(vm - fm) <= LEGENDRE_MID_RTOL * fm else 0.0
+
+
+@njit(cache=True, inline="always")
+def _leg_partial(bc, c, u):
+    """∫_{-1}^{u} Σ_k a_k P_k(v) dv of cell c's Legendre series, a_0 (u + 1) + Σ_{k>=1} a_k
+    (P_{k+1}(u) - P_{k-1}(u))/(2k + 1) (bc.leg holds a_k/(2k + 1) for k >= 1, bc.ra, bc.rb the
+    recurrence P_{k+1} = ra_k u P_k - rb_k P_{k-1}: no division); times w/2 it is the cell's
+    integral up to u."""
+    leg = bc.leg
+    ra = bc.ra
+    rb = bc.rb
+    s = leg[c, 0] * (u + 1.0)
+    pm = 1.0
+    p = u
+    for k in range(1, leg.shape[1]):
+        pn = ra[k] * u * p - rb[k] * pm
+        s += leg[c, k] * (pn - pm)
+        pm = p
+        p = pn
+    return s
 
 
 @njit(cache=True, inline="always")
@@ -246,11 +344,12 @@ def _cells_sum(bc, c0, c1):
 def _barus_cells_rows(tab, sc, rows, bc, short, out):
     """Barus flat rings (:class:`UniformRows`, all with α E* = bc.beta) from the cumulative
     table ``bc`` (:class:`BarusCells`): q L = E* e^{β top - α(p0 - p_b)} ∫_{x_a}^{x_b}
-    σ̄ e^x e^{β(e^x - top)} dx, the whole cells between the ends from the table, the two
-    partial cells by the short rule ``short`` (split at the σ̄ table's nodes)."""
-    nc = bc.pre.size - 1
-    x0 = bc.x0
-    w = bc.w
+    σ̄ e^x e^{β(e^x - top)} dx, the whole cells between the ends from the prefix or suffix
+    sums, the two partial cells from their Legendre series where trusted, else by the short
+    rule ``short`` split at the σ̄ table's nodes (so too a ring inside one cell, and one whose
+    end cells hold more than 8 times its integral: there the partials' round-off would
+    count)."""
+    cells = bc.cells
     for i in prange(rows.p0.size):
         E = rows.E[i]
         p0 = rows.p0[i]
@@ -259,14 +358,25 @@ def _barus_cells_rows(tab, sc, rows, bc, short, out):
         if not xb > xa:
             out[i] = 0.0
             continue
-        ca = min(max(int((xa - x0) / w), 0), nc - 1)
-        cb = min(max(int((xb - x0) / w), 0), nc - 1)
+        ca, sa, wa = _cell_of(bc, xa)
+        cb, sb, wb = _cell_of(bc, xb)
         if ca == cb:
             s = _barus_weighted(tab, sc, bc.beta, bc.top, short, xa, xb)
         else:
-            s = (_barus_weighted(tab, sc, bc.beta, bc.top, short, xa, x0 + (ca + 1) * w)
-                 + _cells_sum(bc, ca + 1, cb)
-                 + _barus_weighted(tab, sc, bc.beta, bc.top, short, x0 + cb * w, xb))
+            ea = sa + wa
+            if bc.ok[ca] != 0.0:
+                lo = cells[ca] - 0.5 * wa * _leg_partial(bc, ca, 2.0 * (xa - sa) / wa - 1.0)
+            else:
+                lo = _barus_weighted(tab, sc, bc.beta, bc.top, short, xa, ea)
+            if bc.ok[cb] != 0.0:
+                hi = 0.5 * wb * _leg_partial(bc, cb, 2.0 * (xb - sb) / wb - 1.0)
+            else:
+                hi = _barus_weighted(tab, sc, bc.beta, bc.top, short, sb, xb)
+            s = lo + _cells_sum(bc, ca + 1, cb) + hi
+            if cells[ca] + cells[cb] > 8.0 * s:
+                s = (_barus_weighted(tab, sc, bc.beta, bc.top, short, xa, ea)
+                     + _cells_sum(bc, ca + 1, cb)
+                     + _barus_weighted(tab, sc, bc.beta, bc.top, short, sb, xb))
         out[i] = E * math.exp(bc.beta * bc.top - rows.A[i] * (p0 - pb)) * s / rows.L[i]
 
 

@@ -254,31 +254,59 @@ SHORT_ORDER = 4
 
 #: Barus flat rings sharing β = α E* in groups of at least BARUS_TABLE_ROWS rows take a
 #: cumulative table of ∫ σ̄ e^x e^{β(e^x - top)} dx (:func:`_barus_cells`): cells of
-#: BARUS_CELL_WIDTH in x = ln(p_cont/E*), each by the full rule; a row then costs the two
-#: partial cells at its ends by BARUS_SHORT_ORDER Gauss points (Barus separates exactly:
+#: BARUS_CELL_WIDTH in x = ln(p_cont/E*), each by the full rule, with the integrand's
+#: Legendre series on the cell; a row then costs the two partial cells at its ends, a
+#: Legendre sum each (BARUS_SHORT_ORDER Gauss points where a cell's series is not trusted:
+#: a σ̄ table node inside it, or next to percolation) (Barus separates exactly:
 #: q L η0 = E* e^{-α(p0 - p_b)} ∫ σ̄ e^x e^{β e^x} dx); β·e^{x_top} above BARUS_BETA_TOP_MAX
 #: (weights below e^-200 at the table's bottom) keeps the per-row integral
-BARUS_CELL_WIDTH = 0.01
+BARUS_CELL_WIDTH = 0.02
+BARUS_TAIL_WIDTH = 0.2
 BARUS_SHORT_ORDER = 4
 BARUS_TABLE_ROWS = 2048
+BARUS_TABLE_SWEEP_ROWS = 8192
 BARUS_BETA_TOP_MAX = 200.0
 
 
 def _barus_cells(tab, sc, beta, quad):
     """The :class:`BarusCells` of β = α E* [-] on the flat ring's range of x = ln(p_cont/E*):
-    from TAIL_CUT below the tables' bottom to the top (or percolation), each cell by the
-    rule ``quad`` (the per-row integral's)."""
+    from TAIL_CUT below the tables' bottom (cells of BARUS_TAIL_WIDTH in the smooth ū³ tail)
+    to the top or percolation (cells of BARUS_CELL_WIDTH), each cell by the rule ``quad``
+    (the per-row integral's)."""
     s = sc[0]
-    x0 = float(s["x_lo"]) - TAIL_CUT
+    xm = float(s["x_lo"])
+    x0 = xm - TAIL_CUT
     x1 = min(float(s["x_hi"]), float(s["x_perc"]))
-    nc = int(math.ceil((x1 - x0) / BARUS_CELL_WIDTH))
-    w = (x1 - x0) / nc
-    top = math.exp(x1)
-    cells = np.empty(nc)
-    _barus_cells_kernel(tab, sc, float(beta), x0, w, top, quad, cells)
-    pre = np.concatenate(([0.0], np.cumsum(cells)))
-    suf = np.concatenate((np.cumsum(cells[::-1])[::-1], [0.0]))
-    return BarusCells(x0, w, top, float(beta), pre, suf)
+    nt = int(math.ceil(TAIL_CUT / BARUS_TAIL_WIDTH))
+    nm = max(int(math.ceil((x1 - xm) / BARUS_CELL_WIDTH)), 1)
+    nc = nt + nm
+    bc = BarusCells(x0, TAIL_CUT / nt, nt, xm, (x1 - xm) / nm, math.exp(x1), float(beta),
+                    np.empty(nc + 1), np.empty(nc + 1), np.empty(nc),
+                    np.empty((nc, quad.x.size)), np.empty(nc), *_legendre_recurrence(quad.x.size))
+    lt, pmid = _legendre_transform(quad.x, quad.w)
+    _barus_cells_kernel(tab, sc, bc, quad, lt, pmid)
+    bc.pre[0] = 0.0
+    np.cumsum(bc.cells, out=bc.pre[1:])
+    bc.suf[nc] = 0.0
+    np.cumsum(bc.cells[::-1], out=bc.suf[nc - 1::-1])
+    return bc
+
+
+def _legendre_recurrence(m):
+    """(ra, rb): P_{k+1}(u) = ra_k u P_k(u) - rb_k P_{k-1}(u), k < m (Bonnet)."""
+    k = np.arange(m, dtype=np.float64)
+    return (2 * k + 1) / (k + 1), k / (k + 1)
+
+
+def _legendre_transform(x, w):
+    """(lt, pmid): a_k = Σ_j lt[k, j] f_j are the Legendre coefficients of the polynomial
+    through the values f_j at the Gauss–Legendre points x (weights w) (exact: the rule
+    integrates P_k times that polynomial), pmid[k] = P_k(0)."""
+    m = x.size
+    P = np.polynomial.legendre.legvander(x, m - 1)  # P[j, k] = P_k(x_j)
+    lt = np.ascontiguousarray(((2 * np.arange(m) + 1) / 2.0)[:, None] * (P * w[:, None]).T)
+    pmid = np.ascontiguousarray(np.polynomial.legendre.legvander(np.zeros(1), m - 1)[0])
+    return lt, pmid
 
 
 def _barus_groups(beta, top):
@@ -305,8 +333,8 @@ def _barus_tabled(tab, sc, sub, quad, out):
     done = np.zeros(out.size, dtype=bool)
     p0, _L, _pa, pb, E, A, _Z = sub
     keys = [k for k in (E, p0, pb, A) if k.min() != k.max()]
-    if not keys or _shares(keys, out.size):  # Δp sweeps: the sweep kernel is faster
-        return done
+    if (not keys or _shares(keys, out.size)) and out.size < BARUS_TABLE_SWEEP_ROWS:
+        return done  # a short Δp sweep: the sweep kernel is faster than building a table
     top = math.exp(min(float(sc[0]["x_hi"]), float(sc[0]["x_perc"])))
     groups = _barus_groups(A * E, top)
     if groups:
@@ -379,7 +407,9 @@ def _uniform_rows(tab, sc, v, law, quad_order, quad_width):
         x, w = gauss_legendre(int(quad_order))
         out = np.empty(int(run.sum()))
         A, Z, pr = law if law is not None else (v["alpha_pv"], np.zeros(E.size), 0.0)
-        sub = [np.ascontiguousarray(a[run], dtype=np.float64) for a in (p0v, Lv, pa, pb, E, A, Z)]
+        every = bool(run.all())  # no row to drop: no copies
+        sub = [np.ascontiguousarray(a if every else a[run], dtype=np.float64)
+               for a in (p0v, Lv, pa, pb, E, A, Z)]
         quad = Quad(x, w, float(quad_width))
         done = _barus_tabled(tab, sc, sub, quad, out) if law is None else np.zeros(out.size, bool)
         rest = np.flatnonzero(~done)
