@@ -16,6 +16,7 @@ import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reference.ext_reynolds import squeeze_time  # noqa: E402
+from frames import assert_columns_match  # noqa: E402
 
 import fastcontact as fc  # noqa: E402
 from fastcontact.squeeze.tire import tire_columns, tire_footprint  # noqa: E402
@@ -114,3 +115,43 @@ def test_start_below_equilibrium_flagged_trapped_rows_too(tables):
     assert list(barus.status) == list(base.status)
     for c in ("t_star", "t_du", "u_exit", "u_trap", "fluid_load_fraction"):
         assert np.all(np.isnan(barus[c])) and np.all(np.isnan(base[c])), c
+
+
+@pytest.mark.parametrize("method", ["fast", "quad"])
+def test_columns_select_what_the_barus_kernel_computes(tables, method, monkeypatch):
+    """With α > 0 a study asking for some columns gets them equal to the full call's, and the
+    Barus kernel computes only the targets they need (its call is spied on: the ratio
+    targets after t_star's 1.01, the Δu targets and whether footprint times reach it); rows
+    with α = 0 in the same call (the base engine) follow the same selection."""
+    import fastcontact.squeeze._barus_fast as bf
+    import fastcontact.squeeze.tire_piezo as tp
+
+    rng = np.random.default_rng(5)
+    n = 30
+    alpha = np.where(rng.random(n) < 0.2, 0.0, ALPHA)
+    kw = dict(p0=rng.uniform(0.05e6, 0.2e6, n), E_star=E_STAR, R=R, eta=ETA,
+              footprint_length=0.1, speed=rng.uniform(5, 40, n), theory="emt",
+              u_start=20 * tables.h_rms, alpha_pv=alpha, method=method)
+    full = tire_footprint(tables, **kw)
+    calls = []
+    name = "tire_kernel" if method == "fast" else "_tire_kernel"
+    mod = bf if method == "fast" else tp
+    real = getattr(mod, name)
+
+    def spy(*args):
+        tg, t_fp = (args[10], args[8]) if method == "fast" else (args[6], args[4])
+        calls.append((tuple(tg.ratios[1:]), tg.dvs.size, t_fp.size > 0))
+        return real(*args)
+
+    monkeypatch.setattr(mod, name, spy)
+    cases = {("t_star", "status"): ((), 0, False),
+             ("t_ratio_1.01", "u_inf"): ((1.01,), 0, False),
+             ("t_du", "t_ratio_1.1", "t_ratio_1.001"): ((1.1, 1.001), 1, False),
+             ("squeeze_complete",): ((), 0, True),
+             ("u_exit", "du_exit", "trapped"): ((), 0, True)}
+    for cols, targets in cases.items():
+        calls.clear()
+        df = tire_footprint(tables, **kw, columns=list(cols))
+        assert list(df.columns) == list(cols)
+        assert calls == [targets], cols
+        assert_columns_match(df, full, cols)

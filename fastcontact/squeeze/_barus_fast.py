@@ -189,6 +189,9 @@ def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, quad
         status[i] = TIRE_OK
         Ts = _target_times(bt, pr, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt,
                            T_out, i)
+        if t_fp.size == 0:  # the exit is not asked for
+            u_exit[i] = math.nan
+            continue
         if Ts < 0.0:
             Ts = t_of_z(pr, st, vinf, zs)
         ic = inverse_constants(pr, st)
@@ -200,8 +203,9 @@ def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, quad
 def tire_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, quad, out,
                 scratch):
     """Barus tire footprint of every case (footprint time t_fp [s] apart) into ``out``
-    (:data:`~.tire_piezo.TireOut`): targets and ū at t_fp from the primitive where it serves
-    the case, else the per-case quadrature (records borrowed as in :func:`squeeze_kernel`)."""
+    (:data:`~.tire_piezo.TireOut`): targets and ū at t_fp (t_fp of size 0: not asked for,
+    u_exit NaN) from the primitive where it serves the case, else the per-case quadrature
+    (records borrowed as in :func:`squeeze_kernel`)."""
     _tire_par(borrowed(tab), borrowed(sc), borrowed(pr), borrowed(bt), borrowed(c), x_fast,
               borrowed(cs), borrowed(alpha), borrowed(t_fp), h, borrowed(tg), borrowed(zt),
               borrowed(lnTs), borrowed(quad), borrowed(out), borrowed(scratch))

@@ -218,16 +218,16 @@ def _check_options(pressure_profile, pressure_model, du_complete, ratios, column
 
 
 def _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out, want):
-    """The squeeze-out columns into ``out``: the base engine (only the targets of the columns
-    in ``want``), or the Barus fluid engine of :mod:`fastcontact.squeeze.tire_piezo` (every
-    column) if any row has α > 0 (issue 14). Returns the model."""
+    """The squeeze-out columns into ``out``: the base engine, or the Barus fluid engine of
+    :mod:`fastcontact.squeeze.tire_piezo` if any row has α > 0 (issue 14); either computes
+    only the targets of the columns in ``want``. Returns the model."""
     if np.any(b["alpha_pv"] > 0.0):
         from .tire_piezo import barus_tire_columns
         b = _full(b, p_eval.size)
         return barus_tire_columns(
             tables, b, p_eval, t_fp, theory, ratios, _ratio_names(ratios), du_complete,
             b["alpha_pv"], out, lambda tb, bb, pe, tf, o: _squeeze_columns(
-                tb, bb, pe, tf, theory, ratios, du_complete, method, o), method)
+                tb, bb, pe, tf, theory, ratios, du_complete, method, o, want), method, want)
     return _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method, out,
                             want)
 

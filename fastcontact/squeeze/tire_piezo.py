@@ -86,37 +86,46 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
         out.u_trap[i] = math.nan
         return
     _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
-    w0 = math.log(vs - vinf)
-    w = exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, quad)
-    out.u_exit[i] = (vinf + math.exp(w)) * h
+    if t_fp.size:  # no footprint times: the exit is not asked for
+        w0 = math.log(vs - vinf)
+        w = exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, quad)
+        out.u_exit[i] = (vinf + math.exp(w)) * h
 
 
 @njit(parallel=True, cache=True)
 def _tire_kernel(tab, sc, cs, alpha, t_fp, h, tg, quad, out):
     """Per case (``cs`` :class:`~fastcontact.squeeze._kernels.Cases`, α [1/Pa] and the
-    footprint time t_fp [s] apart): targets (ratios × v∞, then v∞ + dv) and ū at t_fp, SI,
-    into ``out`` (:data:`TireOut`)."""
+    footprint time t_fp [s] apart): targets (ratios × v∞, then v∞ + dv) and ū at t_fp (t_fp
+    of size 0: none, u_exit NaN), SI, into ``out`` (:data:`TireOut`)."""
     for i in prange(cs.p0.size):
         _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out)
 
 
 def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_complete,
-                       alpha, out, base_columns, method="fast"):
+                       alpha, out, base_columns, method="fast", want=None):
     """Fill the squeeze-out columns of :func:`~fastcontact.squeeze.tire.tire_footprint` with
     a Barus fluid (α = ``alpha`` [1/Pa] per row) into ``out``; rows with α = 0 go to
     ``base_columns(tables, b_subset, p_eval_subset, t_fp_subset, out_subset)`` (the base
-    engine, bit for bit). Returns the base squeeze model (for the frame's attrs)."""
+    engine, bit for bit). ``want`` (a set of column names; None: all) selects what is
+    computed, as in the base engine: a ratio target only for its ``t_ratio_<r>`` column, the
+    Δu target only for ``t_du``, the exit (ū at the footprint time, a Newton of a few
+    inversions: most of a case) only for ``u_exit``, ``du_exit`` or ``squeeze_complete``.
+    Returns the base squeeze model (for the frame's attrs)."""
     from .model import squeeze_model
+    from .tire import _EXIT_COLUMNS
 
     n = p_eval.size
     zero = alpha == 0.0
     sel = np.flatnonzero(~zero)
     m = sel.size
     h = float(tables.h_rms)
-    r = np.asarray(ratios, dtype=np.float64)
+    keep = [k for k, nm in enumerate(ratio_names) if want is None or nm in want]
+    du = want is None or "t_du" in want
+    exit_ = want is None or bool(want & _EXIT_COLUMNS)
+    r = np.asarray(ratios, dtype=np.float64)[keep]
     vr = np.ascontiguousarray(np.concatenate(([1.01], r)))
-    dv = np.array([du_complete / h])
-    T = np.empty((vr.size + 1, m))
+    dv = np.array([du_complete / h] if du else [])
+    T = np.empty((vr.size + dv.size, m))
     ue, ui, us, ut, fl = (np.empty(m) for _ in range(5))
     st = np.empty(m, dtype=np.int8)
     if m:
@@ -124,7 +133,8 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
         x, w = gauss_legendre(QUAD_ORDER)
         p, E, R, eta, al, u0, tf = [np.ascontiguousarray(a, dtype=np.float64) for a in
                                     (p_eval[sel], b["E_star"][sel], b["R"][sel], b["eta"][sel],
-                                     alpha[sel], us_in, t_fp[sel])]
+                                     alpha[sel], us_in, t_fp[sel] if exit_ else t_fp[:0])]
+        ue.fill(np.nan)
         cs, tg = Cases(p, E, R, eta, u0), BarusTargets(vr, dv, np.empty(0))
         quad, res = Quad(x, w, QUAD_WIDTH), TireOut(T, ue, ui, us, ut, fl, st)
         tab, sc = tables.kernel_data(theory), _scalars(tables, theory, None)
@@ -135,13 +145,15 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
                         fast_scratch())
         else:
             _tire_kernel(tab, sc, cs, al, tf, h, tg, quad, res)
-    with np.errstate(invalid="ignore"):
-        piezo = {"u_inf": ui, "u_start": us, "t_du": T[1 + r.size], "t_star": T[0],
-                 "trapped": st == _TRAPPED, "u_trap": ut, "fluid_load_fraction": fl,
-                 "out_of_table": st == _OUT, "u_exit": ue, "du_exit": ue - ui,
-                 "squeeze_complete": (ue - ui) <= du_complete}
-    for k, name in enumerate(ratio_names):
-        piezo[name] = T[1 + k]
+    piezo = {"u_inf": ui, "u_start": us, "t_star": T[0], "trapped": st == _TRAPPED,
+             "u_trap": ut, "fluid_load_fraction": fl, "out_of_table": st == _OUT}
+    if du:
+        piezo["t_du"] = T[1 + r.size]
+    if exit_:
+        with np.errstate(invalid="ignore"):
+            piezo.update(u_exit=ue, du_exit=ue - ui, squeeze_complete=(ue - ui) <= du_complete)
+    for j, k in enumerate(keep):
+        piezo[ratio_names[k]] = T[1 + j]
     codes = np.empty(n, dtype=np.int8)
     codes[sel] = st
     base = {}
