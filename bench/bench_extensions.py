@@ -51,7 +51,7 @@ from fastcontact.flow.anisotropy import (directional_sigma_bar,  # noqa: E402
                                          precompute_directional)
 from fastcontact.flow.conductivity import conductivity  # noqa: E402
 from fastcontact.seal import seal_leak  # noqa: E402
-from fastcontact.seal.viscosity import BARUS_TABLE_SWEEP_ROWS, seal_leak_piezo  # noqa: E402
+from fastcontact.seal.viscosity import SWEEP_TABLE_ROWS, seal_leak_piezo  # noqa: E402
 from fastcontact.squeeze import squeeze_out  # noqa: E402
 from fastcontact.figures.asperity_figures import plot_asperity_tstar  # noqa: E402
 from fastcontact.squeeze.asperity import TIRE_CASE, asperity_levels  # noqa: E402
@@ -204,8 +204,9 @@ def bench_seal(lines, tables, quick, summary):
               f"q L = E* e^(-α(p0-p_b)) ∫σ̄ e^x e^(αE* e^x) dx: a cumulative table of that integral "
               f"per α E*, built in the call, and per row two partial cells from their Legendre "
               f"series); rings of distinct p0 sharing α E* {1e6 * tud / n:.2f} µs/row (same "
-              f"table). Short Δp sweeps (< {BARUS_TABLE_SWEEP_ROWS} rows) add each row's piece to "
-              f"the previous row's integral instead; the Roelands rings always do.", ""]
+              f"table). A Δp sweep of any law of at least {SWEEP_TABLE_ROWS} rows reads a table "
+              f"of its run (the Roelands flat ring below); shorter ones add each row's piece to "
+              f"the previous row's integral.", ""]
     summary.append(("Barus seal", f"O-ring {e_pan:.1e} by panels (DOP853 shooting)",
                     f"O-ring {dps.size / t_pan:.3g} rows/s (200-step shooting "
                     f"{dps.size / t200:.3g}; base table {dps.size / tb:.3g}, base direct "
@@ -621,9 +622,9 @@ def main():
         lines += ["", "Speeds are measured in the same run as their base engines (the machine "
                   "is shared: absolute times are noisy, ratios are the meaningful numbers). "
                   "The Barus squeeze-out and tire footprint run on tables (α p0 <= 0.6); the "
-                  "seal η(p) engines solve per row: quadrature (flat rings; a Δp sweep of one "
-                  "seal adds each row's piece to the previous row's integral; Barus rings "
-                  "sharing α E* read a per-call cumulative table), the base engine's panel "
+                  "seal η(p) engines solve per row: quadrature (flat rings: Barus rings "
+                  "sharing α E* and long Δp sweeps read a per-call cumulative table, short "
+                  "sweeps add each row's piece to the previous row's integral), the base engine's panel "
                   "collocation (Barus O-ring), shooting (Roelands O-ring).",
                   ""]
     lines += body

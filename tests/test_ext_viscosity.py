@@ -267,6 +267,25 @@ def test_seal_uniform_sweep_matches_per_row(tables, law):
             assert abs(got.Q[i] / (q * L_Y) - 1) < 1e-8
 
 
+def _table_calls(tables, kw):
+    """(seal_leak_piezo(tables, **kw), the calls it made of the cumulative-table kernel: each
+    a dict of its table record, scalars, rows, table and output)."""
+    import fastcontact.seal.viscosity as sv
+
+    calls = []
+    real = sv._cells_rows
+
+    def spy(tab, sc, rows, bc, short, full, out):
+        real(tab, sc, rows, bc, short, full, out)
+        calls.append(dict(tab=tab, sc=sc, rows=rows, out=out.copy(), bc=bc))
+
+    sv._cells_rows = spy
+    try:
+        return seal_leak_piezo(tables, **kw), calls
+    finally:
+        sv._cells_rows = real
+
+
 @pytest.mark.parametrize("theory", ["emt", "critical_junction"])
 def test_seal_barus_cells_match_per_row(tables, theory):
     """Barus flat rings of distinct p0 that share α E* take the cumulative table (whole cells
@@ -293,18 +312,7 @@ def test_seal_barus_cells_match_per_row(tables, theory):
     al[-300:] = rng.uniform(1e-6, 4e-6, 300)  # rows of their own α: the per-row path
     kw = dict(p0=p0, dp=dp, p_b=pb, L=5e-3, L_y=L_Y, E_star=E_STAR, eta=ETA, alpha_pv=al,
               theory=theory)
-    calls = []
-    real = sv._barus_cells_rows
-
-    def spy(tab, sc, rows, bc, short, out):
-        real(tab, sc, rows, bc, short, out)
-        calls.append(dict(tab=tab, sc=sc, rows=rows, out=out.copy(), bc=bc))
-
-    sv._barus_cells_rows = spy
-    try:
-        got = seal_leak_piezo(tables, **kw)
-    finally:
-        sv._barus_cells_rows = real
+    got, calls = _table_calls(tables, kw)
     assert (got.status == "ok").all()
     assert len(calls) == 1 and calls[0]["rows"].p0.size >= n - 300  # the shared α's rows
     c = calls[0]
@@ -316,16 +324,11 @@ def test_seal_barus_cells_match_per_row(tables, theory):
     err = np.max(np.abs(c["out"] / ref - 1))
     assert err < 5e-11, err
     # a Δp sweep of one ring long enough for the table (every 97th row checked)
-    m = sv.BARUS_TABLE_SWEEP_ROWS
+    m = sv.SWEEP_TABLE_ROWS
     p_s = 0.5 * p_perc
     dps = p_s * np.sort(np.concatenate([10 ** rng.uniform(-9, -3, m // 4),
                                         rng.uniform(1e-3, 0.999, m - m // 4)]))
-    calls.clear()
-    sv._barus_cells_rows = spy
-    try:
-        sweep = seal_leak_piezo(tables, **dict(kw, p0=p_s, dp=dps, p_b=0.0, alpha_pv=2e-6))
-    finally:
-        sv._barus_cells_rows = real
+    sweep, calls = _table_calls(tables, dict(kw, p0=p_s, dp=dps, p_b=0.0, alpha_pv=2e-6))
     assert len(calls) == 1 and calls[0]["rows"].p0.size == m
     pick = np.arange(0, m, 97)
     rows_s = UniformRows(*(np.ascontiguousarray(a[pick]) for a in calls[0]["rows"]))
@@ -349,14 +352,60 @@ def test_seal_barus_cells_match_per_row(tables, theory):
                         pb[i], al[i])
         assert abs(got.Q[i] / (q * L_Y) - 1) < 1e-8
     # weights beyond e^200 over the table: the per-row path, same numbers
-    big = dict(kw, alpha_pv=np.full(n, 1e-4))
-    calls.clear()
-    sv._barus_cells_rows = spy
-    try:
-        got_big = seal_leak_piezo(tables, **big)
-    finally:
-        sv._barus_cells_rows = real
+    got_big, calls = _table_calls(tables, dict(kw, alpha_pv=np.full(n, 1e-4)))
     assert not calls and (got_big.status == "ok").all() and np.all(got_big.Q > 0)
+
+
+@pytest.mark.parametrize("theory", ["emt", "critical_junction"])
+def test_seal_run_table_matches_per_row(tables, theory):
+    """A long Δp sweep of one Roelands ring next to percolation (SWEEP_TABLE_ROWS rows or more,
+    shuffled, beside a short sweep and rings of their own) reads a cumulative table of its
+    run: equal to every row's own integral with 100x narrower panels and 16 Gauss points to
+    5e-11 (every 61st row checked), the short sweep and the single rings (the sweep kernel) to
+    the same kernel with 10x narrower panels to 5e-8 (its panels are not split at the σ̄ nodes
+    next to percolation), Q rising with Δp."""
+    from fastcontact.kernels.quadrature import gauss_legendre
+    from fastcontact.seal._piezo_kernels import Quad, _uniform_kernel
+    import fastcontact.seal.viscosity as sv
+
+    rng = np.random.default_rng(9)
+    m = sv.SWEEP_TABLE_ROWS + 100
+    p_perc = float(tables.info["percolation_p_over_E"][theory]) * E_STAR
+    p_s = 0.95 * p_perc  # next to percolation: σ̄ nodes dense, cells with nodes inside
+    frac = np.concatenate([10 ** rng.uniform(-9, -3, m // 4), rng.uniform(1e-3, 0.999, m - m // 4),
+                           rng.uniform(1e-3, 0.999, 300), rng.uniform(1e-3, 0.999, 20)])
+    p0 = np.concatenate([np.full(m, p_s), np.full(300, 0.3 * p_perc),
+                         rng.uniform(0.1, 0.9, 20) * p_perc])
+    perm = rng.permutation(p0.size)
+    p0, dp = p0[perm], (p0 * frac)[perm]
+    kw = dict(p0=p0, dp=dp, L=5e-3, L_y=L_Y, E_star=E_STAR, eta=ETA, alpha_pv=1e-7,
+              theory=theory, viscosity="roelands", roelands_z=0.6)
+    got, calls = _table_calls(tables, kw)
+    assert (got.status == "ok").all()
+    assert len(calls) == 1 and calls[0]["rows"].p0.size == m and calls[0]["bc"].run == 1
+    c = calls[0]
+    x, w = gauss_legendre(16)
+    pick = np.arange(0, m, 61)
+    rows = type(c["rows"])(*(np.ascontiguousarray(a[pick]) for a in c["rows"]))
+    ref = np.empty(pick.size)
+    pr = float(c["bc"].pr)
+    _uniform_kernel(c["tab"], c["sc"], rows, pr, Quad(x, w, 0.005), ref)
+    err = np.max(np.abs(c["out"][pick] / ref - 1))
+    assert err < 5e-11, err  # measured 4.6e-13 (panels of 0.05 are themselves off by 6e-11)
+    # every row in its place: the other rows and a sample of the run against the same
+    # reference through Q
+    chk = np.union1d(np.flatnonzero(p0 != p_s), np.arange(0, p0.size, 37))
+    k = chk.size
+    sub = type(c["rows"])(*(np.ascontiguousarray(a, dtype=np.float64) for a in (
+        p0[chk], np.full(k, 5e-3), dp[chk], np.zeros(k), np.full(k, E_STAR),
+        np.full(k, c["bc"].A), np.full(k, c["bc"].Z))))
+    ref_all = np.empty(k)
+    _uniform_kernel(c["tab"], c["sc"], sub, pr, Quad(x, w, 0.05), ref_all)
+    q_ref = L_Y * ref_all * float(tables.h_rms) ** 3 / (12.0 * ETA)
+    np.testing.assert_allclose(got.Q.to_numpy()[chk], q_ref, rtol=5e-8, atol=0)
+    run = p0 == p_s
+    order = np.argsort(dp[run])
+    assert np.all(np.diff(got.Q.to_numpy()[run][order]) > 0)
 
 
 @pytest.mark.parametrize("steps", [None, 200])  # panel collocation (default), shooting

@@ -21,7 +21,7 @@ from ..flow.piezoviscosity import ln_roelands
 from ..kernels.locate import locate_asc
 from ..tables import k_sigma_of_lnp
 
-__all__ = ["TAIL_CUT", "Quad", "UniformRows", "HertzRows", "HertzCase", "BarusCells"]
+__all__ = ["TAIL_CUT", "Quad", "UniformRows", "HertzRows", "HertzCase", "RingCells"]
 
 #: the uniform-ring quadrature starts TAIL_CUT below ln(p_cont_min/E*) of the table (integrand ∝ p_cont)
 TAIL_CUT = 60.0
@@ -49,25 +49,38 @@ class UniformRows(NamedTuple):
     Z: np.ndarray
 
 
-class BarusCells(NamedTuple):
-    """The Barus flat ring's cumulative table for one β = α E* (:func:`_barus_cells_kernel`):
-    cells in x = ln(p_cont/E*), ``nt`` of width ``wt`` from ``x0`` up to ``xm`` (the ū³ tail
-    below the σ̄ table), then cells of width ``w`` from ``xm``; ``top`` = e^{x_top} (the
-    table's upper end), prefix sums ``pre`` (pre[c] = Σ of cells below c) and suffix sums
-    ``suf`` (suf[c] = Σ of cells c and above) of ∫ σ̄ e^x e^{β(e^x - top)} dx over each cell;
-    ``cells`` (nc) the cells' integrals; ``leg`` (nc, m): the integrand's Legendre coefficients
-    a_k on each cell (from its m Gauss points, u = 2(x - x_c)/w - 1), divided by 2k + 1 for
-    k >= 1; ``ra``, ``rb`` (m): (2k + 1)/(k + 1) and k/(k + 1); ``ok`` (nc): 1 where they
-    represent the integrand (no σ̄ table node inside the cell, the midpoint value verified), so
-    that a partial cell is a Legendre sum instead of new σ̄ evaluations."""
+class RingCells(NamedTuple):
+    """A cumulative table of a flat ring's integral ∫ σ̄ e^x W(x) dx in x = ln(p_cont/E*)
+    (:func:`_cells_kernel`), for every ring that shares the weight W:
+
+    * ``run`` = 0 (Barus, one table per β = α E*): W = e^{β(e^x - top)}, ``top`` = e^{x_top};
+      q L = E* e^{β top - α(p0 - p_b)} ∫_{x_a}^{x_b} σ̄ e^x W dx (p0 apart);
+    * ``run`` = 1 (one table per run of rings sharing E*, p0 - p_b = ``P`` E* and the viscosity
+      law ``A``, ``Z``, ``pr`` as in :func:`_ln_eta`: a Δp sweep): W = η0/η(E*(P - e^x));
+      q L = E* ∫_{x_a}^{x_b} σ̄ e^x W dx.
+
+    Cells: ``nt`` of width ``wt`` from ``x0`` up to ``xm`` (the ū³ tail below the σ̄ table),
+    then cells of width ``w`` from ``xm``; prefix sums ``pre`` (pre[c] = Σ of cells below c)
+    and suffix sums ``suf`` (suf[c] = Σ of cells c and above) of the cells' integrals
+    ``cells``; ``leg`` (nc, m): the integrand's Legendre coefficients a_k on each cell (from
+    its m Gauss points, u = 2(x - x_c)/w - 1), divided by 2k + 1 for k >= 1; ``ra``, ``rb``
+    (m): (2k + 1)/(k + 1) and k/(k + 1); ``ok`` (nc): 1 where they represent the integrand (no
+    σ̄ table node inside the cell, the midpoint value verified), so that a partial cell is a
+    Legendre sum instead of new σ̄ evaluations."""
 
     x0: float
     wt: float
     nt: int
     xm: float
     w: float
+    run: int
     top: float
     beta: float
+    E: float
+    P: float
+    A: float
+    Z: float
+    pr: float
     pre: np.ndarray
     suf: np.ndarray
     cells: np.ndarray
@@ -204,24 +217,31 @@ def _uniform_sweep_kernel(tab, sc, rows, pr, quad, short, starts, out):
 
 
 @njit(cache=True, inline="always")
-def _barus_gl(tab, sc, beta, top, quad, a, b):
-    """∫_a^b σ̄ e^x e^{β(e^x - top)} dx, one Gauss–Legendre panel (``quad``'s points)."""
+def _weight(bc, ex):
+    """The weight W of the :class:`RingCells` ``bc`` at e^x = ex."""
+    if bc.run == 0:
+        return math.exp(bc.beta * (ex - bc.top))
+    return math.exp(-_ln_eta(max(bc.P - ex, 0.0) * bc.E, bc.A, bc.Z, bc.pr))
+
+
+@njit(cache=True, inline="always")
+def _ring_gl(tab, sc, bc, quad, a, b):
+    """∫_a^b σ̄ e^x W dx, one Gauss–Legendre panel (``quad``'s points)."""
     half = 0.5 * (b - a)
     mid = a + half
     s = 0.0
     for j in range(quad.x.size):
         x = mid + half * quad.x[j]
         ex = math.exp(x)
-        s += quad.w[j] * _sigma(tab, sc, x) * ex * math.exp(beta * (ex - top))
+        s += quad.w[j] * _sigma(tab, sc, x) * ex * _weight(bc, ex)
     return half * s
 
 
 @njit(cache=True)
-def _barus_weighted(tab, sc, beta, top, quad, a, b):
-    """∫_a^b σ̄ e^x e^{β(e^x - top)} dx (a <= b), one Gauss–Legendre panel between each two
-    of the σ̄ table's nodes inside [a, b] (σ̄ is smooth between nodes only: next to
-    percolation ln σ̄ is linear across unresolved intervals, and the table's bottom joins
-    the ū³ tail)."""
+def _ring_piece(tab, sc, bc, quad, a, b):
+    """∫_a^b σ̄ e^x W dx (a <= b), one Gauss–Legendre panel between each two of the σ̄
+    table's nodes inside [a, b] (σ̄ is smooth between nodes only: next to percolation ln σ̄
+    is linear across unresolved intervals, and the table's bottom joins the ū³ tail)."""
     lnp = tab.lnp
     n = lnp.size
     s = 0.0
@@ -230,10 +250,10 @@ def _barus_weighted(tab, sc, beta, top, quad, a, b):
         k = 0 if a < lnp[0] else locate_asc(a, lnp, tab.bp_lo, tab.bp_dz, tab.bp_idx) + 1
         while k < n and lnp[k] < b:
             if lnp[k] > lo:
-                s += _barus_gl(tab, sc, beta, top, quad, lo, lnp[k])
+                s += _ring_gl(tab, sc, bc, quad, lo, lnp[k])
                 lo = lnp[k]
             k += 1
-    return s + _barus_gl(tab, sc, beta, top, quad, lo, b)
+    return s + _ring_gl(tab, sc, bc, quad, lo, b)
 
 
 #: a cell's Legendre series is trusted where it reproduces the integrand at the cell's
@@ -257,7 +277,7 @@ def _node_inside(tab, a, b):
 
 @njit(cache=True, inline="always")
 def _cell_of(bc, x):
-    """(c, start, width) of the cell of :class:`BarusCells` ``bc`` holding x (clamped)."""
+    """(c, start, width) of the cell of :class:`RingCells` ``bc`` holding x (clamped)."""
     if x < bc.xm:
         c = min(max(int((x - bc.x0) / bc.wt), 0), bc.nt - 1)
         return c, bc.x0 + c * bc.wt, bc.wt
@@ -266,8 +286,8 @@ def _cell_of(bc, x):
 
 
 @njit(parallel=True, cache=True)
-def _barus_cells_kernel(tab, sc, bc, quad, lt, pmid):
-    """bc.cells[c] = ∫ over cell c of σ̄ e^x e^{β(e^x - top)} dx (the rule
+def _cells_kernel(tab, sc, bc, quad, lt, pmid):
+    """bc.cells[c] = ∫ over cell c of σ̄ e^x W dx (:class:`RingCells`; the rule
     ``quad`` on each cell, split at the σ̄ table's nodes), the integrand's Legendre
     coefficients bc.leg[c] from its values at the rule's points (``lt`` (m, m): a_k = Σ_j
     lt[k, j] f_j) and bc.ok[c] (``pmid``: P_k(0), the midpoint check)."""
@@ -275,8 +295,6 @@ def _barus_cells_kernel(tab, sc, bc, quad, lt, pmid):
     cells = bc.cells
     leg = bc.leg
     ok = bc.ok
-    beta = bc.beta
-    top = bc.top
     for c in prange(cells.size):
         if c < bc.nt:
             a = bc.x0 + c * bc.wt
@@ -289,7 +307,7 @@ def _barus_cells_kernel(tab, sc, bc, quad, lt, pmid):
         for j in range(m):
             x = a + 0.5 * w * (1.0 + quad.x[j])
             ex = math.exp(x)
-            f[j] = _sigma(tab, sc, x) * ex * math.exp(beta * (ex - top))
+            f[j] = _sigma(tab, sc, x) * ex * _weight(bc, ex)
             s += quad.w[j] * f[j]
         vm = 0.0
         for k in range(m):
@@ -299,13 +317,13 @@ def _barus_cells_kernel(tab, sc, bc, quad, lt, pmid):
             leg[c, k] = ak if k == 0 else ak / (2 * k + 1)
             vm += ak * pmid[k]
         if _node_inside(tab, a, a + w):
-            cells[c] = _barus_weighted(tab, sc, beta, top, quad, a, a + w)
+            cells[c] = _ring_piece(tab, sc, bc, quad, a, a + w)
             ok[c] = 0.0
         else:
             cells[c] = 0.5 * w * s
             xm = a + 0.5 * w
             em = math.exp(xm)
-            fm = _sigma(tab, sc, xm) * em * math.exp(beta * (em - top))
+            fm = _sigma(tab, sc, xm) * em * _weight(bc, em)
             ok[c] = 1.0 if abs(vm - fm) <= LEGENDRE_MID_RTOL * fm else 0.0
 
 
@@ -340,15 +358,23 @@ def _cells_sum(bc, c0, c1):
     return bc.suf[c0] - bc.suf[c1]
 
 
+@njit(cache=True, inline="always")
+def _rule(bc, c, short, full):
+    """The Gauss rule of a piece in cell c: ``short`` where the cell's Legendre series is
+    trusted (a smooth integrand), else ``full`` (next to percolation ln σ̄ bends sharply
+    between its nodes: 4 points were off by 1.4e-10 there, 10 by 5e-13)."""
+    return short if bc.ok[c] != 0.0 else full
+
+
 @njit(parallel=True, cache=True)
-def _barus_cells_rows(tab, sc, rows, bc, short, out):
-    """Barus flat rings (:class:`UniformRows`, all with α E* = bc.beta) from the cumulative
-    table ``bc`` (:class:`BarusCells`): q L = E* e^{β top - α(p0 - p_b)} ∫_{x_a}^{x_b}
-    σ̄ e^x e^{β(e^x - top)} dx, the whole cells between the ends from the prefix or suffix
-    sums, the two partial cells from their Legendre series where trusted, else by the short
-    rule ``short`` split at the σ̄ table's nodes (so too a ring inside one cell, and one whose
-    end cells hold more than 8 times its integral: there the partials' round-off would
-    count)."""
+def _cells_rows(tab, sc, rows, bc, short, full, out):
+    """Flat rings (:class:`UniformRows`, all sharing the weight of ``bc``) from the cumulative
+    table ``bc`` (:class:`RingCells`): q L = F ∫_{x_a}^{x_b} σ̄ e^x W dx (F = E* e^{β top -
+    α(p0 - p_b)} for a Barus table, E* for a run's), the whole cells between the ends from the
+    prefix or suffix sums, the two partial cells from their Legendre series where trusted,
+    else by Gauss–Legendre split at the σ̄ table's nodes (:func:`_rule`; so too a ring inside
+    one cell, and one whose end cells hold more than 8 times its integral: there the
+    partials' round-off would count)."""
     cells = bc.cells
     for i in prange(rows.p0.size):
         E = rows.E[i]
@@ -361,23 +387,24 @@ def _barus_cells_rows(tab, sc, rows, bc, short, out):
         ca, sa, wa = _cell_of(bc, xa)
         cb, sb, wb = _cell_of(bc, xb)
         if ca == cb:
-            s = _barus_weighted(tab, sc, bc.beta, bc.top, short, xa, xb)
+            s = _ring_piece(tab, sc, bc, _rule(bc, ca, short, full), xa, xb)
         else:
             ea = sa + wa
             if bc.ok[ca] != 0.0:
                 lo = cells[ca] - 0.5 * wa * _leg_partial(bc, ca, 2.0 * (xa - sa) / wa - 1.0)
             else:
-                lo = _barus_weighted(tab, sc, bc.beta, bc.top, short, xa, ea)
+                lo = _ring_piece(tab, sc, bc, full, xa, ea)
             if bc.ok[cb] != 0.0:
                 hi = 0.5 * wb * _leg_partial(bc, cb, 2.0 * (xb - sb) / wb - 1.0)
             else:
-                hi = _barus_weighted(tab, sc, bc.beta, bc.top, short, sb, xb)
+                hi = _ring_piece(tab, sc, bc, full, sb, xb)
             s = lo + _cells_sum(bc, ca + 1, cb) + hi
             if cells[ca] + cells[cb] > 8.0 * s:
-                s = (_barus_weighted(tab, sc, bc.beta, bc.top, short, xa, ea)
+                s = (_ring_piece(tab, sc, bc, _rule(bc, ca, short, full), xa, ea)
                      + _cells_sum(bc, ca + 1, cb)
-                     + _barus_weighted(tab, sc, bc.beta, bc.top, short, sb, xb))
-        out[i] = E * math.exp(bc.beta * bc.top - rows.A[i] * (p0 - pb)) * s / rows.L[i]
+                     + _ring_piece(tab, sc, bc, _rule(bc, cb, short, full), sb, xb))
+        f = E if bc.run != 0 else E * math.exp(bc.beta * bc.top - rows.A[i] * (p0 - pb))
+        out[i] = f * s / rows.L[i]
 
 
 @njit(cache=True)

@@ -11,9 +11,10 @@ conductivity σ0 at the outlet viscosity η0 and the reduced pressure
   ``q = (1/L)∫σ_eff dp``). Evaluated by Gauss–Legendre in ln p_cont on the tables. In
   x = ln(p_cont/E*) it is q L = E* e^{-α(p0 - p_b)} ∫_{x_a}^{x_b} σ̄ e^x e^{αE* e^x} dx: the
   weight does not depend on p0, so rings sharing α E* (but not p0) read one cumulative table
-  of that integral per call (cells of 0.01 in x, prefix and suffix sums) and integrate only
-  the two partial cells at their ends (:func:`_barus_cells`); rings sharing the whole
-  integrand (a Δp sweep) add each row's piece to the previous row's integral.
+  of that integral per call (cells of 0.02 in x, prefix and suffix sums, the integrand's
+  Legendre series on each cell) and evaluate only the two partial cells at their ends
+  (:func:`_ring_cells`); a long Δp sweep of any law shares one such table of its run, and a
+  short one adds each row's piece to the previous row's integral.
 * **Hertz O-ring** (p0(x) = p_H √(1 - ((x-a)/a)²)): dψ/dx = -q/σ0(p0(x) - p_f(ψ)) has no
   closed form. Integrated from the outlet, ψ(x) = q ∫_x^{x_e} dx'/σ0, so with
   W = ∫_{x_s}^{x_e} dx/σ0 over the sealing zone p0(x) >= p_f, q = ψ_a/W and
@@ -53,9 +54,8 @@ from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from . import _panels
 from .context import NEAR_LIFT_OFF, seal_context, solve_profile_rows, solver_options
-from ._piezo_kernels import (TAIL_CUT, BarusCells, HertzRows, Quad, UniformRows,
-                             _barus_cells_kernel, _barus_cells_rows, _hertz_kernel,
-                             _hertz_kernel_r, _uniform_sweep_kernel)
+from ._piezo_kernels import (TAIL_CUT, HertzRows, Quad, RingCells, UniformRows, _cells_kernel,
+                             _cells_rows, _hertz_kernel, _hertz_kernel_r, _uniform_sweep_kernel)
 
 __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
 
@@ -252,39 +252,43 @@ SHORT_WIDTH = 0.04
 SHORT_ORDER = 4
 
 
-#: Barus flat rings sharing β = α E* in groups of at least BARUS_TABLE_ROWS rows take a
-#: cumulative table of ∫ σ̄ e^x e^{β(e^x - top)} dx (:func:`_barus_cells`): cells of
-#: BARUS_CELL_WIDTH in x = ln(p_cont/E*), each by the full rule, with the integrand's
-#: Legendre series on the cell; a row then costs the two partial cells at its ends, a
-#: Legendre sum each (BARUS_SHORT_ORDER Gauss points where a cell's series is not trusted:
-#: a σ̄ table node inside it, or next to percolation) (Barus separates exactly:
-#: q L η0 = E* e^{-α(p0 - p_b)} ∫ σ̄ e^x e^{β e^x} dx); β·e^{x_top} above BARUS_BETA_TOP_MAX
-#: (weights below e^-200 at the table's bottom) keeps the per-row integral
-BARUS_CELL_WIDTH = 0.02
-BARUS_TAIL_WIDTH = 0.2
-BARUS_SHORT_ORDER = 4
+#: Flat rings that share the weight of their integral take a cumulative table of it
+#: (:class:`RingCells`, :func:`_ring_cells`): cells of CELL_WIDTH in x = ln(p_cont/E*)
+#: (TAIL_WIDTH in the ū³ tail), each by the full rule, with the integrand's Legendre series;
+#: a ring then costs the two partial cells at its ends, a Legendre sum each (Gauss points
+#: split at the σ̄ nodes where a cell's series is not trusted: a σ̄ table node inside it, or
+#: next to percolation; CELL_SHORT_ORDER of them for a ring inside one smooth cell). Barus
+#: rings separate exactly, q L η0 = E* e^{-α(p0 - p_b)} ∫ σ̄ e^x e^{β e^x} dx with
+#: β = α E*, so rings sharing β (BARUS_TABLE_ROWS of them or more; distinct p0 too)
+#: share one table (β·e^{x_top} above BARUS_BETA_TOP_MAX, weights below e^-200 at the
+#: table's bottom, keeps the per-row integral); rings of any law sharing p0 - p_b, E* and the
+#: law (a Δp sweep of SWEEP_TABLE_ROWS rings or more) share one table of their run. Shorter
+#: sweeps add each ring's piece to the previous one's integral (:func:`_sweep_order`)
+CELL_WIDTH = 0.02
+TAIL_WIDTH = 0.2
+CELL_SHORT_ORDER = 4
 BARUS_TABLE_ROWS = 2048
-BARUS_TABLE_SWEEP_ROWS = 8192
+SWEEP_TABLE_ROWS = 8192
 BARUS_BETA_TOP_MAX = 200.0
 
 
-def _barus_cells(tab, sc, beta, quad):
-    """The :class:`BarusCells` of β = α E* [-] on the flat ring's range of x = ln(p_cont/E*):
-    from TAIL_CUT below the tables' bottom (cells of BARUS_TAIL_WIDTH in the smooth ū³ tail)
-    to the top or percolation (cells of BARUS_CELL_WIDTH), each cell by the rule ``quad``
-    (the per-row integral's)."""
-    s = sc[0]
-    xm = float(s["x_lo"])
+def _ring_cells(tab, sc, quad, x1, run=0, beta=0.0, E=0.0, P=0.0, A=0.0, Z=0.0, pr=0.0):
+    """The :class:`RingCells` on x = ln(p_cont/E*) from TAIL_CUT below the tables' bottom
+    (cells of TAIL_WIDTH in the smooth ū³ tail) to x1 (cells of CELL_WIDTH), each cell by the
+    rule ``quad`` (the per-row integral's): a Barus table (run 0, β = α E* [-], top e^{x1})
+    or a run's (run 1: E* [Pa], P = (p0 - p_b)/E* [-] = e^{x1} and the law A, Z, pr of
+    :func:`._piezo_kernels._ln_eta`)."""
+    xm = float(sc[0]["x_lo"])
     x0 = xm - TAIL_CUT
-    x1 = min(float(s["x_hi"]), float(s["x_perc"]))
-    nt = int(math.ceil(TAIL_CUT / BARUS_TAIL_WIDTH))
-    nm = max(int(math.ceil((x1 - xm) / BARUS_CELL_WIDTH)), 1)
+    nt = int(math.ceil(TAIL_CUT / TAIL_WIDTH))
+    nm = max(int(math.ceil((x1 - xm) / CELL_WIDTH)), 1)
     nc = nt + nm
-    bc = BarusCells(x0, TAIL_CUT / nt, nt, xm, (x1 - xm) / nm, math.exp(x1), float(beta),
-                    np.empty(nc + 1), np.empty(nc + 1), np.empty(nc),
-                    np.empty((nc, quad.x.size)), np.empty(nc), *_legendre_recurrence(quad.x.size))
+    bc = RingCells(x0, TAIL_CUT / nt, nt, xm, (x1 - xm) / nm, int(run), math.exp(x1),
+                   float(beta), float(E), float(P), float(A), float(Z), float(pr),
+                   np.empty(nc + 1), np.empty(nc + 1), np.empty(nc), np.empty((nc, quad.x.size)),
+                   np.empty(nc), *_legendre_recurrence(quad.x.size))
     lt, pmid = _legendre_transform(quad.x, quad.w)
-    _barus_cells_kernel(tab, sc, bc, quad, lt, pmid)
+    _cells_kernel(tab, sc, bc, quad, lt, pmid)
     bc.pre[0] = 0.0
     np.cumsum(bc.cells, out=bc.pre[1:])
     bc.suf[nc] = 0.0
@@ -309,6 +313,23 @@ def _legendre_transform(x, w):
     return lt, pmid
 
 
+def _table_rows(tab, sc, sub, idx, bc, quad, out, done):
+    """Rings ``idx`` of the columns ``sub`` (None: all) from the table ``bc`` into ``out``
+    (partial cells by CELL_SHORT_ORDER Gauss points where the integrand is smooth, else by
+    the full rule ``quad``)."""
+    xs, ws = gauss_legendre(CELL_SHORT_ORDER)
+    short = Quad(xs, ws, CELL_WIDTH)
+    if idx is None:
+        _cells_rows(tab, sc, UniformRows(*sub), bc, short, quad, out)
+        done[:] = True
+        return
+    o = np.empty(idx.size)
+    _cells_rows(tab, sc, UniformRows(*(np.ascontiguousarray(a[idx]) for a in sub)), bc, short,
+                quad, o)
+    out[idx] = o
+    done[idx] = True
+
+
 def _barus_groups(beta, top):
     """[(β, rows)] of the Barus flat rings that take a cumulative table: groups of at least
     BARUS_TABLE_ROWS rows sharing β = α E* with β·top <= BARUS_BETA_TOP_MAX (rows None: all
@@ -325,33 +346,45 @@ def _barus_groups(beta, top):
         (cnt >= BARUS_TABLE_ROWS) & (u * top <= BARUS_BETA_TOP_MAX))]
 
 
-def _barus_tabled(tab, sc, sub, quad, out):
+def _barus_tabled(tab, sc, sub, quad, out, done):
     """Fill ``out`` for the Barus flat rings (columns ``sub`` as in :func:`_uniform_rows`) that
-    take a cumulative table (:func:`_barus_groups`); returns the mask of rows filled. Batches
-    with runs of a shared integrand (Δp sweeps of one seal) keep the sweep kernel: a row there
-    costs a piece between two inlet ends, cheaper than the two partial cells here."""
-    done = np.zeros(out.size, dtype=bool)
+    share a β table (:func:`_barus_groups`), marking them in ``done``. A short Δp sweep (fewer
+    than SWEEP_TABLE_ROWS rings) keeps the sweep kernel: building a table costs more there."""
     p0, _L, _pa, pb, E, A, _Z = sub
     keys = [k for k in (E, p0, pb, A) if k.min() != k.max()]
-    if (not keys or _shares(keys, out.size)) and out.size < BARUS_TABLE_SWEEP_ROWS:
-        return done  # a short Δp sweep: the sweep kernel is faster than building a table
-    top = math.exp(min(float(sc[0]["x_hi"]), float(sc[0]["x_perc"])))
-    groups = _barus_groups(A * E, top)
-    if groups:
-        xs, ws = gauss_legendre(BARUS_SHORT_ORDER)
-        short = Quad(xs, ws, BARUS_CELL_WIDTH)
-    for beta, idx in groups:
-        bc = _barus_cells(tab, sc, beta, quad)
-        if idx is None:
-            _barus_cells_rows(tab, sc, UniformRows(*sub), bc, short, out)
-            done[:] = True
-        else:
-            o = np.empty(idx.size)
-            _barus_cells_rows(tab, sc, UniformRows(*(np.ascontiguousarray(a[idx]) for a in sub)),
-                              bc, short, o)
-            out[idx] = o
-            done[idx] = True
-    return done
+    if (not keys or _shares(keys, out.size)) and out.size < SWEEP_TABLE_ROWS:
+        return
+    x1 = min(float(sc[0]["x_hi"]), float(sc[0]["x_perc"]))
+    for beta, idx in _barus_groups(A * E, math.exp(x1)):
+        _table_rows(tab, sc, sub, idx, _ring_cells(tab, sc, quad, x1, 0, beta), quad, out, done)
+
+
+def _run_tabled(tab, sc, sub, pr, quad, out, done):
+    """Fill ``out`` for the flat rings not ``done`` in runs of at least SWEEP_TABLE_ROWS rings
+    sharing p0, p_b, E* and the law (a long Δp sweep), one table per run."""
+    todo = np.flatnonzero(~done)
+    if todo.size < SWEEP_TABLE_ROWS:
+        return
+    cols = sub if todo.size == out.size else [a[todo] for a in sub]
+    p0, _L, _pa, pb, E, A, Z = cols
+    keys = [k for k in (E, p0, pb, A, Z) if k.min() != k.max()]
+    if keys and not _shares(keys, todo.size):
+        return
+    order = np.lexsort(keys[::-1]) if keys else np.arange(todo.size)
+    first = np.flatnonzero(_new_runs(keys, order)) if keys else np.zeros(1, dtype=np.int64)
+    ends = np.append(first[1:], todo.size)
+    x_lo = float(sc[0]["x_lo"])
+    for f, e in zip(first, ends):
+        if e - f < SWEEP_TABLE_ROWS:
+            continue
+        r = order[f]
+        P = (p0[r] - pb[r]) / E[r]
+        x1 = math.log(P)
+        if not x1 > x_lo + CELL_WIDTH:  # the run lies in the ū³ tail: per-row integrals
+            continue
+        bc = _ring_cells(tab, sc, quad, x1, 1, 0.0, E[r], P, A[r], Z[r], pr)
+        whole = e - f == out.size  # one sweep: every row, no gather
+        _table_rows(tab, sc, sub, None if whole else todo[order[f:e]], bc, quad, out, done)
 
 
 def _new_runs(keys, order):
@@ -411,7 +444,10 @@ def _uniform_rows(tab, sc, v, law, quad_order, quad_width):
         sub = [np.ascontiguousarray(a if every else a[run], dtype=np.float64)
                for a in (p0v, Lv, pa, pb, E, A, Z)]
         quad = Quad(x, w, float(quad_width))
-        done = _barus_tabled(tab, sc, sub, quad, out) if law is None else np.zeros(out.size, bool)
+        done = np.zeros(out.size, dtype=bool)
+        if law is None:
+            _barus_tabled(tab, sc, sub, quad, out, done)
+        _run_tabled(tab, sc, sub, float(pr), quad, out, done)
         rest = np.flatnonzero(~done)
         if rest.size:
             if rest.size < out.size:
