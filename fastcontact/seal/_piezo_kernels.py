@@ -60,7 +60,9 @@ class RingCells(NamedTuple):
       q L = E* ∫_{x_a}^{x_b} σ̄ e^x W dx.
 
     Cells: ``nt`` of width ``wt`` from ``x0`` up to ``xm`` (the ū³ tail below the σ̄ table),
-    then cells of width ``w`` from ``xm``; prefix sums ``pre`` (pre[c] = Σ of cells below c)
+    then cells of at most ``w`` from ``xm``, on a grid of spacing ``w`` cut at the σ̄ table's
+    nodes (so that σ̄ is smooth inside every cell); ``cs`` (nc + 1) the cells' bounds,
+    ``first`` the cell holding each grid point xm + k w; prefix sums ``pre`` (pre[c] = Σ of cells below c)
     and suffix sums ``suf`` (suf[c] = Σ of cells c and above) of the cells' integrals
     ``cells``; ``leg`` (nc, m): the integrand's Legendre coefficients a_k on each cell (from
     its m Gauss points, u = 2(x - x_c)/w - 1), divided by 2k + 1 for k >= 1; ``ra``, ``rb``
@@ -81,6 +83,8 @@ class RingCells(NamedTuple):
     A: float
     Z: float
     pr: float
+    cs: np.ndarray
+    first: np.ndarray
     pre: np.ndarray
     suf: np.ndarray
     cells: np.ndarray
@@ -278,11 +282,14 @@ def _node_inside(tab, a, b):
 @njit(cache=True, inline="always")
 def _cell_of(bc, x):
     """(c, start, width) of the cell of :class:`RingCells` ``bc`` holding x (clamped)."""
+    cs = bc.cs
     if x < bc.xm:
         c = min(max(int((x - bc.x0) / bc.wt), 0), bc.nt - 1)
-        return c, bc.x0 + c * bc.wt, bc.wt
-    c = min(int((x - bc.xm) / bc.w), bc.cells.size - bc.nt - 1)
-    return bc.nt + c, bc.xm + c * bc.w, bc.w
+        return c, cs[c], cs[c + 1] - cs[c]
+    c = bc.first[min(int((x - bc.xm) / bc.w), bc.first.size - 1)]
+    while c + 2 < cs.size and cs[c + 1] <= x:  # a node cut between the grid point and x
+        c += 1
+    return c, cs[c], cs[c + 1] - cs[c]
 
 
 @njit(parallel=True, cache=True)
@@ -296,12 +303,8 @@ def _cells_kernel(tab, sc, bc, quad, lt, pmid):
     leg = bc.leg
     ok = bc.ok
     for c in prange(cells.size):
-        if c < bc.nt:
-            a = bc.x0 + c * bc.wt
-            w = bc.wt
-        else:
-            a = bc.xm + (c - bc.nt) * bc.w
-            w = bc.w
+        a = bc.cs[c]
+        w = bc.cs[c + 1] - a
         f = np.empty(m)
         s = 0.0
         for j in range(m):

@@ -254,10 +254,10 @@ SHORT_ORDER = 4
 
 #: Flat rings that share the weight of their integral take a cumulative table of it
 #: (:class:`RingCells`, :func:`_ring_cells`): cells of CELL_WIDTH in x = ln(p_cont/E*)
-#: (TAIL_WIDTH in the ū³ tail), each by the full rule, with the integrand's Legendre series;
-#: a ring then costs the two partial cells at its ends, a Legendre sum each (Gauss points
-#: split at the σ̄ nodes where a cell's series is not trusted: a σ̄ table node inside it, or
-#: next to percolation; CELL_SHORT_ORDER of them for a ring inside one smooth cell). Barus
+#: (TAIL_WIDTH in the ū³ tail) cut at the σ̄ table's nodes, each by the full rule, with the
+#: integrand's Legendre series; a ring then costs the two partial cells at its ends, a
+#: Legendre sum each (Gauss points where a cell's series is not trusted, next to
+#: percolation; CELL_SHORT_ORDER of them for a ring inside one smooth cell). Barus
 #: rings separate exactly, q L η0 = E* e^{-α(p0 - p_b)} ∫ σ̄ e^x e^{β e^x} dx with
 #: β = α E*, so rings sharing β (BARUS_TABLE_ROWS of them or more; distinct p0 too)
 #: share one table (β·e^{x_top} above BARUS_BETA_TOP_MAX, weights below e^-200 at the
@@ -274,17 +274,27 @@ BARUS_BETA_TOP_MAX = 200.0
 
 def _ring_cells(tab, sc, quad, x1, run=0, beta=0.0, E=0.0, P=0.0, A=0.0, Z=0.0, pr=0.0):
     """The :class:`RingCells` on x = ln(p_cont/E*) from TAIL_CUT below the tables' bottom
-    (cells of TAIL_WIDTH in the smooth ū³ tail) to x1 (cells of CELL_WIDTH), each cell by the
-    rule ``quad`` (the per-row integral's): a Barus table (run 0, β = α E* [-], top e^{x1})
+    (cells of TAIL_WIDTH in the smooth ū³ tail) to x1 (cells of CELL_WIDTH, cut at the σ̄
+    table's nodes), each cell by the rule ``quad`` (the per-row integral's): a Barus table (run 0, β = α E* [-], top e^{x1})
     or a run's (run 1: E* [Pa], P = (p0 - p_b)/E* [-] = e^{x1} and the law A, Z, pr of
     :func:`._piezo_kernels._ln_eta`)."""
     xm = float(sc[0]["x_lo"])
     x0 = xm - TAIL_CUT
     nt = int(math.ceil(TAIL_CUT / TAIL_WIDTH))
     nm = max(int(math.ceil((x1 - xm) / CELL_WIDTH)), 1)
-    nc = nt + nm
-    bc = RingCells(x0, TAIL_CUT / nt, nt, xm, (x1 - xm) / nm, int(run), math.exp(x1),
-                   float(beta), float(E), float(P), float(A), float(Z), float(pr),
+    wm = (x1 - xm) / nm
+    grid = xm + wm * np.arange(nm + 1)
+    grid[-1] = x1
+    # the grid cut at the σ̄ nodes inside it (a cut closer than 1e-9 to a bound is dropped)
+    bm = np.union1d(grid, tab.lnp[(tab.lnp > xm) & (tab.lnp < x1)])
+    bm = bm[np.concatenate(([True], np.diff(bm) > 1e-9))]
+    bm[-1] = x1
+    cs = np.ascontiguousarray(np.concatenate((x0 + (TAIL_CUT / nt) * np.arange(nt), bm)))
+    first = np.ascontiguousarray(nt + np.searchsorted(bm, grid[:-1], side="right") - 1,
+                                 dtype=np.int64)
+    nc = cs.size - 1
+    bc = RingCells(x0, TAIL_CUT / nt, nt, xm, wm, int(run), math.exp(x1), float(beta),
+                   float(E), float(P), float(A), float(Z), float(pr), cs, first,
                    np.empty(nc + 1), np.empty(nc + 1), np.empty(nc), np.empty((nc, quad.x.size)),
                    np.empty(nc), *_legendre_recurrence(quad.x.size))
     lt, pmid = _legendre_transform(quad.x, quad.w)
