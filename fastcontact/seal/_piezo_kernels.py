@@ -18,7 +18,6 @@ import numpy as np
 from numba import njit, prange
 
 from ..flow.piezoviscosity import ln_roelands
-from ..kernels.locate import locate_asc
 from ..tables import k_sigma_of_lnp
 
 __all__ = ["TAIL_CUT", "Quad", "UniformRows", "HertzRows", "HertzCase", "RingCells"]
@@ -62,13 +61,13 @@ class RingCells(NamedTuple):
     Cells: ``nt`` of width ``wt`` from ``x0`` up to ``xm`` (the ū³ tail below the σ̄ table),
     then cells of at most ``w`` from ``xm``, on a grid of spacing ``w`` cut at the σ̄ table's
     nodes (so that σ̄ is smooth inside every cell); ``cs`` (nc + 1) the cells' bounds,
-    ``first`` the cell holding each grid point xm + k w; prefix sums ``pre`` (pre[c] = Σ of cells below c)
-    and suffix sums ``suf`` (suf[c] = Σ of cells c and above) of the cells' integrals
+    ``first`` the cell holding each grid point xm + k w; prefix sums ``pre`` (pre[c] = Σ of
+    cells below c) and suffix sums ``suf`` (suf[c] = Σ of cells c and above) of the cells' integrals
     ``cells``; ``leg`` (nc, m): the integrand's Legendre coefficients a_k on each cell (from
     its m Gauss points, u = 2(x - x_c)/w - 1), divided by 2k + 1 for k >= 1; ``ra``, ``rb``
-    (m): (2k + 1)/(k + 1) and k/(k + 1); ``ok`` (nc): 1 where they represent the integrand (no
-    σ̄ table node inside the cell, the midpoint value verified), so that a partial cell is a
-    Legendre sum instead of new σ̄ evaluations."""
+    (m): (2k + 1)/(k + 1) and k/(k + 1); ``ok`` (nc): 1 where they represent the integrand
+    (verified at the cell's midpoint), so that a partial cell is a Legendre sum instead of new
+    σ̄ evaluations."""
 
     x0: float
     wt: float
@@ -241,42 +240,10 @@ def _ring_gl(tab, sc, bc, quad, a, b):
     return half * s
 
 
-@njit(cache=True)
-def _ring_piece(tab, sc, bc, quad, a, b):
-    """∫_a^b σ̄ e^x W dx (a <= b), one Gauss–Legendre panel between each two of the σ̄
-    table's nodes inside [a, b] (σ̄ is smooth between nodes only: next to percolation ln σ̄
-    is linear across unresolved intervals, and the table's bottom joins the ū³ tail)."""
-    lnp = tab.lnp
-    n = lnp.size
-    s = 0.0
-    lo = a
-    if b > lnp[0] and a < lnp[n - 1]:
-        k = 0 if a < lnp[0] else locate_asc(a, lnp, tab.bp_lo, tab.bp_dz, tab.bp_idx) + 1
-        while k < n and lnp[k] < b:
-            if lnp[k] > lo:
-                s += _ring_gl(tab, sc, bc, quad, lo, lnp[k])
-                lo = lnp[k]
-            k += 1
-    return s + _ring_gl(tab, sc, bc, quad, lo, b)
-
-
 #: a cell's Legendre series is trusted where it reproduces the integrand at the cell's
 #: midpoint to this relative tolerance (the series' error is largest there; ~1e-15 on cells
 #: where ln σ̄ is smooth and |d ln f/dx| w <= 0.3)
 LEGENDRE_MID_RTOL = 1e-12
-
-
-@njit(cache=True, inline="always")
-def _node_inside(tab, a, b):
-    """Whether a node of the σ̄ table lies strictly inside (a, b)."""
-    lnp = tab.lnp
-    n = lnp.size
-    if a < lnp[0]:
-        return lnp[0] < b
-    if a >= lnp[n - 1]:
-        return False
-    i = locate_asc(a, lnp, tab.bp_lo, tab.bp_dz, tab.bp_idx)
-    return i + 1 < n and a < lnp[i + 1] < b
 
 
 @njit(cache=True, inline="always")
@@ -295,7 +262,7 @@ def _cell_of(bc, x):
 @njit(parallel=True, cache=True)
 def _cells_kernel(tab, sc, bc, quad, lt, pmid):
     """bc.cells[c] = ∫ over cell c of σ̄ e^x W dx (:class:`RingCells`; the rule
-    ``quad`` on each cell, split at the σ̄ table's nodes), the integrand's Legendre
+    ``quad`` on each cell: the cells are cut at the σ̄ table's nodes), the integrand's Legendre
     coefficients bc.leg[c] from its values at the rule's points (``lt`` (m, m): a_k = Σ_j
     lt[k, j] f_j) and bc.ok[c] (``pmid``: P_k(0), the midpoint check)."""
     m = quad.x.size
@@ -319,15 +286,11 @@ def _cells_kernel(tab, sc, bc, quad, lt, pmid):
                 ak += lt[k, j] * f[j]
             leg[c, k] = ak if k == 0 else ak / (2 * k + 1)
             vm += ak * pmid[k]
-        if _node_inside(tab, a, a + w):
-            cells[c] = _ring_piece(tab, sc, bc, quad, a, a + w)
-            ok[c] = 0.0
-        else:
-            cells[c] = 0.5 * w * s
-            xm = a + 0.5 * w
-            em = math.exp(xm)
-            fm = _sigma(tab, sc, xm) * em * _weight(bc, em)
-            ok[c] = 1.0 if abs(vm - fm) <= LEGENDRE_MID_RTOL * fm else 0.0
+        cells[c] = 0.5 * w * s
+        xm = a + 0.5 * w
+        em = math.exp(xm)
+        fm = _sigma(tab, sc, xm) * em * _weight(bc, em)
+        ok[c] = 1.0 if abs(vm - fm) <= LEGENDRE_MID_RTOL * fm else 0.0
 
 
 @njit(cache=True, inline="always")
@@ -375,7 +338,7 @@ def _cells_rows(tab, sc, rows, bc, short, full, out):
     table ``bc`` (:class:`RingCells`): q L = F ∫_{x_a}^{x_b} σ̄ e^x W dx (F = E* e^{β top -
     α(p0 - p_b)} for a Barus table, E* for a run's), the whole cells between the ends from the
     prefix or suffix sums, the two partial cells from their Legendre series where trusted,
-    else by Gauss–Legendre split at the σ̄ table's nodes (:func:`_rule`; so too a ring inside
+    else by Gauss–Legendre (:func:`_rule`; σ̄ is smooth inside a cell; so too a ring inside
     one cell, and one whose end cells hold more than 8 times its integral: there the
     partials' round-off would count)."""
     cells = bc.cells
@@ -390,22 +353,22 @@ def _cells_rows(tab, sc, rows, bc, short, full, out):
         ca, sa, wa = _cell_of(bc, xa)
         cb, sb, wb = _cell_of(bc, xb)
         if ca == cb:
-            s = _ring_piece(tab, sc, bc, _rule(bc, ca, short, full), xa, xb)
+            s = _ring_gl(tab, sc, bc, _rule(bc, ca, short, full), xa, xb)
         else:
             ea = sa + wa
             if bc.ok[ca] != 0.0:
                 lo = cells[ca] - 0.5 * wa * _leg_partial(bc, ca, 2.0 * (xa - sa) / wa - 1.0)
             else:
-                lo = _ring_piece(tab, sc, bc, full, xa, ea)
+                lo = _ring_gl(tab, sc, bc, full, xa, ea)
             if bc.ok[cb] != 0.0:
                 hi = 0.5 * wb * _leg_partial(bc, cb, 2.0 * (xb - sb) / wb - 1.0)
             else:
-                hi = _ring_piece(tab, sc, bc, full, sb, xb)
+                hi = _ring_gl(tab, sc, bc, full, sb, xb)
             s = lo + _cells_sum(bc, ca + 1, cb) + hi
             if cells[ca] + cells[cb] > 8.0 * s:
-                s = (_ring_piece(tab, sc, bc, _rule(bc, ca, short, full), xa, ea)
+                s = (_ring_gl(tab, sc, bc, _rule(bc, ca, short, full), xa, ea)
                      + _cells_sum(bc, ca + 1, cb)
-                     + _ring_piece(tab, sc, bc, _rule(bc, cb, short, full), sb, xb))
+                     + _ring_gl(tab, sc, bc, _rule(bc, cb, short, full), sb, xb))
         f = E if bc.run != 0 else E * math.exp(bc.beta * bc.top - rows.A[i] * (p0 - pb))
         out[i] = f * s / rows.L[i]
 

@@ -275,9 +275,9 @@ BARUS_BETA_TOP_MAX = 200.0
 def _ring_cells(tab, sc, quad, x1, run=0, beta=0.0, E=0.0, P=0.0, A=0.0, Z=0.0, pr=0.0):
     """The :class:`RingCells` on x = ln(p_cont/E*) from TAIL_CUT below the tables' bottom
     (cells of TAIL_WIDTH in the smooth ū³ tail) to x1 (cells of CELL_WIDTH, cut at the σ̄
-    table's nodes), each cell by the rule ``quad`` (the per-row integral's): a Barus table (run 0, β = α E* [-], top e^{x1})
-    or a run's (run 1: E* [Pa], P = (p0 - p_b)/E* [-] = e^{x1} and the law A, Z, pr of
-    :func:`._piezo_kernels._ln_eta`)."""
+    table's nodes), each cell by the rule ``quad`` (the per-row integral's): a Barus table
+    (run 0, β = α E* [-], top e^{x1}) or a run's (run 1: E* [Pa], P = (p0 - p_b)/E* [-] =
+    e^{x1} and the law A, Z, pr of :func:`._piezo_kernels._ln_eta`)."""
     xm = float(sc[0]["x_lo"])
     x0 = xm - TAIL_CUT
     nt = int(math.ceil(TAIL_CUT / TAIL_WIDTH))
@@ -377,11 +377,10 @@ def _run_tabled(tab, sc, sub, pr, quad, out, done):
         return
     cols = sub if todo.size == out.size else [a[todo] for a in sub]
     p0, _L, _pa, pb, E, A, Z = cols
-    keys = [k for k in (E, p0, pb, A, Z) if k.min() != k.max()]
-    if keys and not _shares(keys, todo.size):
+    order, new_run = _runs(cols, by_pa=False)
+    if order is None:
         return
-    order = np.lexsort(keys[::-1]) if keys else np.arange(todo.size)
-    first = np.flatnonzero(_new_runs(keys, order)) if keys else np.zeros(1, dtype=np.int64)
+    first = np.flatnonzero(new_run)
     ends = np.append(first[1:], todo.size)
     x_lo = float(sc[0]["x_lo"])
     for f, e in zip(first, ends):
@@ -416,19 +415,29 @@ def _shares(keys, n, sample=2048):
     return not _new_runs(smp, np.lexsort(smp[::-1])).all()
 
 
-def _sweep_order(sub):
-    """(order, starts) for :func:`_uniform_sweep_kernel`: the rows (p0, L, p_a, p_b, E*, A, Z)
-    sorted into runs sharing E*, p0, p_b, A, Z (the integrand), ascending p_a within a run, and
-    the first row of each chunk (a run cut every SWEEP_CHUNK rows; the row count last). order
-    None: the rows as they are, each its own run (:func:`_shares` found no shared one)."""
+def _runs(sub, by_pa=True):
+    """(order, new_run) of the rows (p0, L, p_a, p_b, E*, A, Z): sorted into runs sharing E*,
+    p0, p_b, A, Z (the integrand), ascending p_a within a run if ``by_pa``, and True at each
+    run's first row; (None, None) where :func:`_shares` finds no shared integrand."""
     p0, _L, pa, pb, E, A, Z = sub
     keys = [k for k in (E, p0, pb, A, Z) if k.min() != k.max()]  # the ones that vary
-    n = pa.size
-    if keys and not _shares(keys, n):  # every row its own integrand: rows as they are
+    if keys and not _shares(keys, pa.size):
+        return None, None
+    if by_pa:  # one run (a Δp sweep of one seal) if no key varies
+        order = np.lexsort([pa] + keys[::-1]) if keys else np.argsort(pa, kind="stable")
+    else:
+        order = np.lexsort(keys[::-1]) if keys else np.arange(pa.size)
+    return order, _new_runs(keys, order)
+
+
+def _sweep_order(sub):
+    """(order, starts) for :func:`_uniform_sweep_kernel`: the rows in :func:`_runs` order and
+    the first row of each chunk (a run cut every SWEEP_CHUNK rows; the row count last). order
+    None: the rows as they are, each its own run (:func:`_shares` found no shared one)."""
+    n = sub[0].size
+    order, new_run = _runs(sub)
+    if order is None:  # every row its own integrand: rows as they are
         return None, np.arange(n + 1, dtype=np.int64)
-    # one run (a Δp sweep of one seal) if no key varies
-    order = np.lexsort([pa] + keys[::-1]) if keys else np.argsort(pa, kind="stable")
-    new_run = _new_runs(keys, order)
     first = np.flatnonzero(new_run)
     # each run cut into chunks of SWEEP_CHUNK rows (they run in parallel)
     run_id = np.cumsum(new_run) - 1
