@@ -463,6 +463,39 @@ def test_emt_does_not_depend_on_the_order_of_the_pressures(psd):
     assert np.array_equal(a.details.u1_evaluations, b.details.u1_evaluations[::-1])
 
 
+def test_tables_emt_takes_fewer_u1_points_only_far_from_percolation(monkeypatch):
+    """At a table's tolerance (1e-7) the effective medium evaluates u1 with FAR_ORDER points
+    per panel where A(ζ1)/A0 < FAR_AREA × A_c: there σ̄ still meets the tolerance against
+    the independent generalized-medium quadrature (:mod:`fastcontact.validation.emt`) and a
+    tight direct quadrature, on a tabulated road spectrum (a kink at each sample); closer to
+    percolation the rule is the 10-point one, bit for bit. Fails if the switch is ignored
+    (equal results far away) or misplaced (differences next to percolation)."""
+    import fastcontact.flow.conductivity as cond
+    from fastcontact.flow._kernels import FAR_AREA
+    from fastcontact.flow.conductivity import emt_sigma_bar_started
+    from fastcontact.roaddb import synthetic_road_psd
+    from fastcontact.validation import emt
+
+    _, q, C = synthetic_road_psd(np.random.default_rng(1))
+    road = fc.TabulatedPSD(q, C)
+    A1 = np.array([1e-6, 1e-3, 0.05, 0.2, 0.35, 0.44, 0.46, 0.48])
+    G1 = 0.25 * math.pi * road.cum3[-1]
+    from scipy.special import erfinv
+    p = np.ascontiguousarray(2.0 * math.sqrt(G1) * erfinv(A1))
+    none = (np.zeros((p.size, 1)), np.zeros(p.size, dtype=np.int64))
+    far = emt_sigma_bar_started(road, p, *none, tol=1e-7)[0].sigma_bar
+    monkeypatch.setattr(cond, "FAR_AREA", 0.0)
+    full = emt_sigma_bar_started(road, p, *none, tol=1e-7)[0].sigma_bar
+    inner = A1 < FAR_AREA * 0.5
+    assert not np.any(far[inner] == full[inner])      # the far rule was taken
+    assert np.array_equal(far[~inner], full[~inner])  # not next to percolation
+    ref = emt.emt_sigma_bar(road, p[inner])
+    tight = sigma_bar(road, p[inner], "emt", tol=1e-12).sigma_bar
+    # measured <= 4.6e-9 against both (the 10-point rule's errors are the same to 1e-11)
+    assert np.max(np.abs(far[inner] / ref - 1)) < 2e-8
+    assert np.max(np.abs(far[inner] / tight - 1)) < 2e-8
+
+
 def test_emt_started_on_a_neighbours_partition_meets_the_same_tolerance(psd):
     """A table build starts each midpoint's effective-medium quadrature on a neighbouring
     node's final partition (:class:`fastcontact.flow.panel_memory.PanelMemory`): the result
