@@ -485,7 +485,7 @@ def bench_roelands(lines, summary, tables, quick):
         lines.append(f"| {d / 1e6:g} | {qb[i] / q0[i]:.3f} | {qr[i] / q0[i]:.3f} |")
     lines += ["", "Roelands (Z < 1) stiffens less than Barus at 100 MPa: the leak rate reduction "
               "is smaller. No reduced pressure exists in closed form for it: the flat ring uses "
-              "the separated integral, the O-ring integrates in p_f itself.", ""]
+              "the separated integral, the O-ring the panel collocation in a tabulated ψ.", ""]
     summary.append(("Roelands seal", f"flat ring {eu:.1e} (solve_bvp); O-ring {eh200:.1e} at "
                     f"200 steps, default (checked) {e_def:.1e} (DOP853); next to lift-off "
                     f"default {e_near['default']:.1e}, 200 steps {e_near[200]:.1e} (vs 12800 steps)",
@@ -631,7 +631,8 @@ def main():
                   "seal η(p) engines solve per row: quadrature (flat rings: Barus rings "
                   "sharing α E* and long Δp sweeps read a per-call cumulative table, short "
                   "sweeps add each row's piece to the previous row's integral), the base engine's panel "
-                  "collocation (Barus O-ring), shooting (Roelands O-ring).",
+                  "collocation in ψ (O-rings; Roelands: ψ tabulated per row, shooting where its "
+                  "Newton fails).",
                   ""]
     lines += body
     out = HERE / ("extensions_results.md" if args.only == ap.get_default("only")

@@ -15,8 +15,10 @@ __all__ = ["Zone", "State", "Work", "Mesh"]
 class Zone(NamedTuple):
     """The sealing zone of one case (one argument instead of seven): profile kind (0 Hertz,
     1 array), zone parameters gp (:func:`._mesh.zone_params`), the array profile's samples
-    xg, pg, the reduced pressures π_a, π_b at the ends, and the fluid's reduced Barus
-    coefficient α̃ = α_pv E* (0: constant viscosity; :mod:`._panels`)."""
+    xg, pg, the reduced pressures π_a, π_b at the ends, the fluid's reduced Barus
+    coefficient α̃ = α_pv E* (0: constant viscosity; :mod:`._panels`) and its Roelands law
+    vis = (A, Z, π_r = p_r/E*) (A = vis[0] > 0: a Roelands fluid, then al = 0;
+    :mod:`._roelands_psi`)."""
 
     kind: int
     gp: np.ndarray
@@ -25,6 +27,7 @@ class Zone(NamedTuple):
     pia: float
     pib: float
     al: float
+    vis: np.ndarray
 
 
 class State(NamedTuple):

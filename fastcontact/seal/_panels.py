@@ -34,6 +34,7 @@ from numba import njit, prange
 from ._mesh import (array_zone, geometry, interp_series, panel_series, remaining_fraction,
                     solve_small, zone_params)
 from ._panel_records import Mesh, State, Work, Zone, _work
+from ._roelands_psi import eta_ratio, fluid_of, no_psi_table, psi_of, psi_table
 from ._sigma import sig_d
 
 __all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "ST_OK", "ST_NOT_REFINED",
@@ -67,6 +68,39 @@ def _remaining(dpf, psia, al):
     return -math.expm1(-al * dpf) / al / psia
 
 
+@njit(cache=True, inline="always")
+def _drop_v(dpi, al, rt):
+    """ψ_a of the zone's fluid: :func:`_psi_drop`, or the Roelands table's ψ(Δπ)."""
+    if rt.y.size:
+        return psi_of(rt, dpi)
+    return _psi_drop(dpi, al)
+
+
+@njit(cache=True, inline="always")
+def _fluid_v(psi, al, rt):
+    """π_f − π_b of a reduced ψ: :func:`_fluid`, or the Roelands table's inverse."""
+    if rt.y.size:
+        return fluid_of(rt, psi)
+    return _fluid(psi, al)
+
+
+@njit(cache=True, inline="always")
+def _remaining_v(dpf, psia, al, rt):
+    """ψ/ψ_a of a fluid pressure π_f − π_b = dpf: :func:`_remaining`, or by the Roelands
+    table."""
+    if rt.y.size:
+        return psi_of(rt, dpf) / psia
+    return _remaining(dpf, psia, al)
+
+
+@njit(cache=True)
+def _zone_psi(zone):
+    """The :data:`~._roelands_psi.PsiTable` of the zone's Roelands fluid (empty: none)."""
+    if zone.vis.size and zone.vis[0] > 0.0:
+        return psi_table(zone.vis[0], zone.vis[1], zone.vis[2], zone.pia - zone.pib)
+    return no_psi_table()
+
+
 @njit(cache=True)
 def _fill_nodes(zone, rule, wk, P):
     """Nodes t, ξ, dξ/dt, e_a, e_b of the P panels of wk.pan."""
@@ -84,10 +118,13 @@ def _fill_nodes(zone, rule, wk, P):
 
 
 @njit(cache=True)
-def _resid(tab, sc, rule, st, dxi, eb, dpi, al, pan, P):
+def _resid(tab, sc, rule, st, dxi, eb, dpi, al, rt, pan, P):
     """r = dξ/dt / σ̄(c), D = dr/dc, R̃ and F at c (the :class:`State` st) on the mesh pan;
     returns (W, max|F|, ok). Not the whole :class:`Work`: it is called per line-search step.
-    ``dpi`` is ψ_a (= Δπ for a constant viscosity, α̃ = ``al`` = 0).
+    ``dpi`` is ψ_a (= Δπ for a constant viscosity, α̃ = ``al`` = 0). A Roelands fluid (``rt``
+    a non-empty :data:`~._roelands_psi.PsiTable`) has no closed-form inverse of ψ: its F is
+    written in ψ and scaled back to a pressure, F_i = (ψ(π_f,i) − ψ_a R̃_i/W) η(π_f,i)/η0,
+    π_f,i = e_b,i − c_i (the same root; to first order in F the same as e_b − c − P(ψ)).
 
     ok is False if σ̄ = 0 somewhere (c at/after percolation: infinite resistance)."""
     n, wl, At = rule.n, rule.wl, rule.At
@@ -120,8 +157,12 @@ def _resid(tab, sc, rule, st, dxi, eb, dpi, al, pan, P):
     if not W > 0.0:
         return W, math.inf, False
     fmax = 0.0
+    roel = rt.y.size > 0
     for i in range(N):
-        if al == 0.0:
+        if roel:
+            pf = eb[i] - c[i]
+            F[i] = (psi_of(rt, pf) - dpi * Rt[i] / W) * eta_ratio(rt, pf)
+        elif al == 0.0:
             F[i] = eb[i] - c[i] - dpi * Rt[i] / W
         else:
             F[i] = eb[i] - c[i] - _fluid(dpi * Rt[i] / W, al)
@@ -131,15 +172,17 @@ def _resid(tab, sc, rule, st, dxi, eb, dpi, al, pan, P):
 
 
 @njit(cache=True)
-def _newton(tab, sc, rule, wk, dpi, al, P, maxit, ftol):
+def _newton(tab, sc, rule, wk, dpi, al, rt, P, maxit, ftol):
     """Damped Newton on the current mesh wk.pan from wk.s0; wk.s0.c and wk.s0.r hold the
-    result. Returns (W, its, ok). ``dpi`` is ψ_a, ``al`` α̃ (:func:`_resid`)."""
+    result. Returns (W, its, ok). ``dpi`` is ψ_a, ``al`` α̃, ``rt`` the Roelands table
+    (:func:`_resid`)."""
     n, wl, At = rule.n, rule.wl, rule.At
     pan, y1, y2, Y, K, dxi, eb = wk.pan, wk.y1, wk.y2, wk.Y, wk.K, wk.dxi, wk.eb
     N = P * n
-    W, fmax, ok = _resid(tab, sc, rule, wk.s0, dxi, eb, dpi, al, pan, P)
+    W, fmax, ok = _resid(tab, sc, rule, wk.s0, dxi, eb, dpi, al, rt, pan, P)
     if not ok:
         return W, 0, False
+    roel = rt.y.size > 0
     cur = 0          # 0: current state in wk.s0; 1: in wk.s1
     its = 0
     conv = False
@@ -158,8 +201,12 @@ def _newton(tab, sc, rule, wk, dpi, al, P, maxit, ftol):
         for p in range(P - 1, -1, -1):
             hh = 0.5 * (pan[p + 1] - pan[p])
             for i in range(n):
-                # Barus: row i's coupling times P'(ψ_i) = 1/(1 − α̃ ψ_i) (1 for α̃ = 0)
-                gi = g if al == 0.0 else g / (1.0 - al * g * RR[p * n + i])
+                # Barus: row i's coupling times P'(ψ_i) = 1/(1 − α̃ ψ_i) (1 for α̃ = 0);
+                # Roelands: times η/η0 at the node's fluid pressure (F scaled by it)
+                if roel:
+                    gi = g * eta_ratio(rt, eb[p * n + i] - cc[p * n + i])
+                else:
+                    gi = g if al == 0.0 else g / (1.0 - al * g * RR[p * n + i])
                 for k in range(n):
                     K[i, k] = -gi * hh * At[i, k] * DD[p * n + k]
                 K[i, i] -= 1.0
@@ -188,7 +235,7 @@ def _newton(tab, sc, rule, wk, dpi, al, P, maxit, ftol):
         for ls in range(24):
             for i in range(N):
                 ct[i] = cc[i] + lam * y1[i]
-            Wt, ft, okt = _resid(tab, sc, rule, trial, dxi, eb, dpi, al, pan, P)
+            Wt, ft, okt = _resid(tab, sc, rule, trial, dxi, eb, dpi, al, rt, pan, P)
             if okt and ft <= (1.0 - 1e-4 * lam) * fmax:
                 accepted = True
                 break
@@ -211,7 +258,7 @@ def _newton(tab, sc, rule, wk, dpi, al, P, maxit, ftol):
 
 
 @njit(cache=True)
-def _first_guess(zone, m, wk, N, cperc, init_P, init_s):
+def _first_guess(zone, rt, m, wk, N, cperc, init_P, init_s):
     """Initial contact pressure c (into wk.s0.c) at the N nodes: c = e_b − Δπ s with
     s = init_s (continuation, init_P > 0) or the fluid pressure linear in ξ across the zone
     (Barus: s the remaining fraction of ψ, c = e_b − P(ψ_a s)),
@@ -219,7 +266,7 @@ def _first_guess(zone, m, wk, N, cperc, init_P, init_s):
     kind, gp, xg, pg, pia, pib = zone.kind, zone.gp, zone.xg, zone.pg, zone.pia, zone.pib
     xi, eb, c = wk.xi, wk.eb, wk.s0.c
     dpi = pia - pib
-    psia = _psi_drop(dpi, zone.al)
+    psia = _drop_v(dpi, zone.al, rt)
     scale = dpi
     for i in range(N):
         scale = max(scale, abs(eb[i]))
@@ -230,7 +277,7 @@ def _first_guess(zone, m, wk, N, cperc, init_P, init_s):
             s = init_s[i]
         else:
             s = (g1 - xi[i]) / (g1 - g0) if g1 > g0 else 0.5
-        ci = eb[i] - _fluid(psia * s, zone.al)
+        ci = eb[i] - _fluid_v(psia * s, zone.al, rt)
         if ci > 0.9 * cperc and init_P == 0:
             ci = 0.9 * cperc
         c[i] = ci
@@ -298,7 +345,8 @@ def solve_case(tab, sc, rule, tol, maxit, zone, out, init_P, init_pan, init_s, s
     n, P0, PMAX = rule.n, rule.P0, rule.PMAX
     Lp = rule.Lp
     al = zone.al
-    dpi = _psi_drop(zone.pia - zone.pib, al)  # ψ_a: Δπ for a constant viscosity
+    rt = _zone_psi(zone)
+    dpi = _drop_v(zone.pia - zone.pib, al, rt)  # ψ_a: Δπ for a constant viscosity
     wk = _work(n, PMAX)
     pan, pan2, err, coef, after, Pk = wk.pan, wk.pan2, wk.err, wk.coef, wk.after, wk.Pk
     c, r, eb, y1 = wk.s0.c, wk.s0.r, wk.eb, wk.y1
@@ -306,7 +354,7 @@ def solve_case(tab, sc, rule, tol, maxit, zone, out, init_P, init_pan, init_s, s
     for p in range(P + 1):
         pan[p] = init_pan[p] if init_P > 0 else p / P
     _fill_nodes(zone, rule, wk, P)
-    ftol = _first_guess(zone, rule.m, wk, P * n, sc.p_perc, init_P, init_s)
+    ftol = _first_guess(zone, rt, rule.m, wk, P * n, sc.p_perc, init_P, init_s)
     status = ST_OK
     total_it = 0
     est = math.inf
@@ -315,7 +363,7 @@ def solve_case(tab, sc, rule, tol, maxit, zone, out, init_P, init_pan, init_s, s
     for rnd in range(4 * PMAX + 1):
         # intermediate meshes: converge loosely (the indicator needs r to ~1e-9 only); the
         # final mesh: polish to round-off (each round adds a panel: the bound is never reached)
-        W, its, conv = _newton(tab, sc, rule, wk, dpi, al, P, maxit,
+        W, its, conv = _newton(tab, sc, rule, wk, dpi, al, rt, P, maxit,
                                ftol if polish else 1e4 * ftol)
         total_it += its
         if not conv:
@@ -337,11 +385,11 @@ def solve_case(tab, sc, rule, tol, maxit, zone, out, init_P, init_pan, init_s, s
         P = Pn
         _fill_nodes(zone, rule, wk, P)
         for i in range(P * n):
-            c[i] = eb[i] - _fluid(dpi * y1[i], al)
+            c[i] = eb[i] - _fluid_v(dpi * y1[i], al, rt)
     _copy_mesh(P, n, pan, c, r, out.pan, out.c, out.r)
     if s_out.size >= P * n:
         for i in range(P * n):
-            s_out[i] = _remaining(eb[i] - c[i], dpi, al)
+            s_out[i] = _remaining_v(eb[i] - c[i], dpi, al, rt)
     return W, status, P, est, total_it
 
 
@@ -394,14 +442,14 @@ def _refine_previous(rule, r_prev, pan, P, W_prev, coef, after, Pk, new):
 
 
 @njit(cache=True)
-def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, al, out):
+def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, al, vis, out):
     """solve_case, and if Newton fails from the plain initial guess (close to percolation,
     where ln σ̄ falls by ~10³ per unit ln p), continuation in p_a: start where the peak
     contact pressure max p0 − p_a is 0.6 p_perc (or halfway in p_a for the average theory),
     then step the distance to percolation δ = p_perc − (max p0 − p_a) geometrically down to
     its target, each step starting from the previous solution on the previous mesh.
     ``out`` (:class:`Mesh`) receives the final mesh, c and r; ``al`` α̃ of a Barus fluid (0:
-    constant viscosity).
+    constant viscosity), ``vis`` the Roelands law (A, Z, π_r) (size 0 or A = 0: none).
     Returns (W, status, panels, error_estimate, newton_iterations, continuation_steps)."""
     n, PMAX = rule.n, rule.PMAX
     gp = np.empty(3)
@@ -409,7 +457,7 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, al, out):
         return 0.0, ST_NO_ZONE, 0, 0.0, 0, 0
     nil = np.empty(0)
     W, st, P, est, its = solve_case(tab, sc, rule, rule.tol, rule.maxit,
-                                    Zone(kind, gp, xg, pg, pia, pib, al), out, 0, nil, nil, nil)
+                                    Zone(kind, gp, xg, pg, pia, pib, al, vis), out, 0, nil, nil, nil)
     if st != ST_NEWTON_FAILED:
         return W, st, P, est, its, 0
     cperc = sc.p_perc
@@ -423,7 +471,8 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, al, out):
     rr = np.empty(NMAX)
     zone_params(kind, base, xg, pg, pa0, pib, gp)
     W, st, P, est, it0 = solve_case(tab, sc, rule, 1e-2, rule.maxit,
-                                    Zone(kind, gp, xg, pg, pa0, pib, al), Mesh(pan, cc, rr), 0,
+                                    Zone(kind, gp, xg, pg, pa0, pib, al, vis), Mesh(pan, cc, rr),
+                                    0,
                                     pan, sn, sn)
     its += it0
     if st == ST_NEWTON_FAILED:
@@ -448,7 +497,7 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, al, out):
             pa = pia
         zone_params(kind, base, xg, pg, pa, pib, gp)
         W2, st2, P2, est2, it2 = solve_case(tab, sc, rule, rule.tol, min(rule.maxit, 25),
-                                            Zone(kind, gp, xg, pg, pa, pib, al),
+                                            Zone(kind, gp, xg, pg, pa, pib, al, vis),
                                             Mesh(pan_new, cc, rr), P, pan, sn, s_new)
         its += it2
         if st2 == ST_NEWTON_FAILED:
@@ -476,9 +525,10 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, al, out):
 
 
 @njit(cache=True)
-def solve_row(tab, sc, rule, kind, xg, p0n, amp, pia, pib, al, mesh):
+def solve_row(tab, sc, rule, kind, xg, p0n, amp, pia, pib, al, vis, mesh):
     """One soft seal: (W, status, panels, error_estimate, x_s, x_e); ``al`` α̃ = α E* of a
-    Barus fluid (0: constant viscosity; W is then the resistance of ψ_a, q ∝ ψ_a/W).
+    Barus fluid (0: constant viscosity; W is then the resistance of ψ_a, q ∝ ψ_a/W), ``vis``
+    a Roelands law (A, Z, π_r) (size 0: none; W the resistance of its ψ_a).
 
     kind 0, Hertz: amp = π_H (p0n unused); kind 1, array: p0 = p0n·amp at ξ = xg (p0n [Pa],
     amp = 1/E*). Reduced π_a, π_b. W = ∫dξ/σ̄ over the sealing zone; ``mesh``
@@ -488,14 +538,14 @@ def solve_row(tab, sc, rule, kind, xg, p0n, amp, pia, pib, al, mesh):
         base1 = np.empty(1)
         base1[0] = amp
         W, st, P, est, its, cs = solve_robust(tab, sc, rule, 0, base1, xg, p0n, amp, pia, pib,
-                                              al, mesh)
+                                              al, vis, mesh)
         xs = math.nan
         xe = math.nan
     else:
         pg = p0n * amp
         xs, xe = array_zone(xg, pg, pia, pib)
         W, st, P, est, its, cs = solve_robust(tab, sc, rule, 1, pg, xg, pg, pg.max(), pia, pib,
-                                              al, mesh)
+                                              al, vis, mesh)
     return W, st, P, est, xs, xe
 
 
@@ -511,14 +561,15 @@ def _store_row(out, i, W, st, P, est, xs, xe):
 
 
 @njit(cache=True, parallel=True)
-def solve_rows(tab, sc, rule, kind, xg, p0n, amp, pia, pib, al, rows, out):
+def solve_rows(tab, sc, rule, kind, xg, p0n, amp, pia, pib, al, vis, rows, out):
     """Soft seals of the rows listed in ``rows`` (parallel; see :func:`solve_row`) into
     ``out`` (flat record of arrays W, status, panels, err, xs, xe); ``al`` per row (α̃ of a
-    Barus fluid, 0: constant viscosity)."""
+    Barus fluid, 0: constant viscosity), ``vis`` (rows, 3) the Roelands law (A, Z, π_r) per
+    row, or (rows, 0): none."""
     for j in prange(rows.size):
         i = rows[j]
         mesh = Mesh(np.empty(rule.PMAX + 1), np.empty(rule.PMAX * rule.n),
                     np.empty(rule.PMAX * rule.n))
         W, st, P, est, xs, xe = solve_row(tab, sc, rule, kind, xg, p0n, amp[i], pia[i], pib[i],
-                                          al[i], mesh)
+                                          al[i], vis[i], mesh)
         _store_row(out, i, W, st, P, est, xs, xe)

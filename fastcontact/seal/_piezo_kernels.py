@@ -4,8 +4,8 @@ Uniform ring: ``q L = ∫_{p_b}^{p_a} σ0(p0 - p) η0/η(p) dp`` by composite Ga
 ln p_cont (Barus is the p_r = 0 case of the Roelands weight). Hertz O-ring: shooting on
 k = 12 η0 q / h³ with RK4 on steps graded towards both zone ends, in the reduced pressure ψ
 (Barus) or in p_f itself (Roelands), bracketed secant iteration in k started from the root of
-a coarse (25-step) shooting — the Roelands O-ring, and the Barus one when ``steps`` is given
-(its default is the base engine's panel collocation in ψ, :mod:`fastcontact.seal._panels`).
+a coarse (25-step) shooting — both laws' O-rings when ``steps`` is given, and the rows whose
+default, the base engine's panel collocation in ψ (:mod:`fastcontact.seal._panels`), fails.
 The wrapper and the equations: :mod:`fastcontact.seal.viscosity`. ``sc`` is the scalar record of
 :func:`fastcontact.seal.viscosity._scalars` (read as ``sc[0].x_lo``).
 """

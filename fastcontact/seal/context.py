@@ -376,19 +376,20 @@ def panel_rule(o, tol=None, max_panels=None):
                      float(o["tol"] if tol is None else tol), int(o["max_newton"]), z, w, At, Lp)
 
 
-def solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, near, al=None):
+def solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, near, al=None, vis=None):
     """The soft-seal solver (:func:`._panels.solve_rows`) on rows ``idx`` into a fresh
     :class:`RowsOut`: rows with ``near`` (at or within NEAR_LIFT_OFF below lift-off) at the
     panel tolerance min(tol, EQUALITY_TOL) and at least 256 panels, the others with the
     options ``o`` as they are; ``al`` the rows' reduced Barus α̃ = α E* (None: 0, a constant
-    viscosity)."""
+    viscosity), ``vis`` (rows, 3) their Roelands law (A, Z, π_r = p_r/E*) (None: none)."""
     out = RowsOut.empty(amp.size)
     al = np.zeros(amp.size) if al is None else np.ascontiguousarray(al, dtype=np.float64)
+    vis = np.zeros((amp.size, 0)) if vis is None else np.ascontiguousarray(vis, dtype=np.float64)
     for sel, nr in ((idx[~near], False), (idx[near], True)):
         if not sel.size:
             continue
         rule = panel_rule(o, tol=min(o["tol"], EQUALITY_TOL) if nr else None,
                           max_panels=max(o["max_panels"], 256) if nr else None)
-        _panels.solve_rows(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pia, pib, al,
+        _panels.solve_rows(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pia, pib, al, vis,
                            np.ascontiguousarray(sel, dtype=np.int64), out)
     return out

@@ -72,7 +72,8 @@ def _solve_W(sc, piH, pia, equal):
         rule = panel_rule(o, tol=1e-9 if eq else TABLE_TOL, max_panels=256)
         _panels.solve_rows(sc.tab, sc.rec, rule, 0, np.zeros(2), np.zeros(2),
                            np.ascontiguousarray(piH), np.ascontiguousarray(pia),
-                           np.zeros(piH.size), np.zeros(piH.size), idx.astype(np.int64), out)
+                           np.zeros(piH.size), np.zeros(piH.size), np.zeros((piH.size, 0)),
+                           idx.astype(np.int64), out)
     return np.where(out.status == _panels.ST_NEWTON_FAILED, np.nan, out.W)
 
 

@@ -165,7 +165,7 @@ def _general_fluid(sc, geo, pa, pb, dp, E, xo, row, o):
     mesh = _panels.Mesh(np.empty(rule.PMAX + 1), np.empty(rule.PMAX * rule.n),
                         np.empty(rule.PMAX * rule.n))
     W, _, P, _, _, _ = _panels.solve_row(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pa / E,
-                                         pb / E, 0.0, mesh)
+                                         pb / E, 0.0, np.zeros(0), mesh)
     gp = np.empty(3)
     _mesh.zone_params(kind, base, xg, pg, pa / E, pb / E, gp)
     frac = np.empty(n_out)

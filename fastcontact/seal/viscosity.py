@@ -28,15 +28,17 @@ conductivity σ0 at the outlet viscosity η0 and the reduced pressure
 In both, ``p_f(ψ) = p_b - ln(1 - αψ)/α``; ψ < 1/α always since ψ_a = ψ(p_a) < 1/α.
 
 **Roelands** (``viscosity="roelands"``, :mod:`fastcontact.flow.piezoviscosity`):
-ln(η/η0) = A[(1 + (p_f - p_b)/p_r)^Z - 1]. The reduced-pressure trick does **not** carry
-over: ψ(p) = ∫η0/η dp is an incomplete gamma function with no closed-form inverse, and
-p_cont = p0(x) - p_f needs p_f(ψ). So
+ln(η/η0) = A[(1 + (p_f - p_b)/p_r)^Z - 1]. The reduced pressure ψ(p) = ∫η0/η dp is an
+incomplete gamma function with no closed-form inverse, and p_cont = p0(x) - p_f needs
+p_f(ψ). So
 
 * uniform ring: the separated equation holds for any η(p),
   ``q L = ∫_{p_b}^{p_a} σ0(p0 - p) η0/η(p) dp`` (same quadrature, Roelands weight);
-* Hertz O-ring: the Reynolds equation is integrated in p_f itself,
-  dp_f/dθ = -k a sin θ (η(p_f)/η0)/σ̄((p_H sin θ - p_f)/E*), by the same graded RK4 and
-  shooting on k (no ψ anywhere).
+* Hertz O-ring: the same panel collocation in ψ as Barus, with ψ tabulated per row
+  (:mod:`._roelands_psi`: quintic Hermite in ln(1 + p/p_r), exact to ~1e-13) and the
+  residual written in ψ (no inverse inside the Newton); rows whose Newton fails (steep laws
+  next to lift-off) are shot in p_f itself, dp_f/dθ = -k a sin θ (η(p_f)/η0)/σ̄((p_H sin θ -
+  p_f)/E*), by the same graded RK4 and shooting on k, checked.
 
 References: C. Barus, Am. J. Sci. 45, 87 (1893), doi:10.2475/ajs.s3-45.266.87;
 B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019.
@@ -56,12 +58,13 @@ from . import _panels
 from .context import NEAR_LIFT_OFF, seal_context, solve_profile_rows, solver_options
 from ._piezo_kernels import (TAIL_CUT, HertzRows, Quad, RingCells, UniformRows, _cells_kernel,
                              _cells_rows, _hertz_kernel, _hertz_kernel_r, _uniform_sweep_kernel)
+from ._roelands_psi import psi_drops
 
 __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
 
 #: RK4 steps across the Hertz sealing zone (graded; error <= ~1e-8 against an adaptive
-#: DOP853 shooting reference, bench/bench_extensions.py): the Roelands O-ring, and the Barus
-#: O-ring's shooting when ``steps`` is given
+#: DOP853 shooting reference, bench/bench_extensions.py): the O-ring shooting (given
+#: ``steps``, and the fallback of rows whose panel Newton fails)
 HERTZ_STEPS = 200
 #: panel tolerance of the Barus O-ring's collocation solve (the base seal engine's solver in
 #: ψ; relative Legendre tail of the resistance density per panel); at or within
@@ -69,13 +72,13 @@ HERTZ_STEPS = 200
 #: converges slowly in the tolerance, the base engine's EQUALITY_TOL
 #: (bench/extensions_results.md)
 BARUS_PANEL_TOL = 1e-7
-#: the default shooting of O-rings (Roelands; Barus rows whose panel Newton fails, α p_H >~ 5
-#: next to lift-off) is checked (:func:`_checked_shooting`): (HERTZ_STEPS/2, HERTZ_STEPS) steps,
+#: the default shooting of O-rings (rows whose panel Newton fails: Barus at α p_H >~ 5 next
+#: to lift-off, steep Roelands laws) is checked (:func:`_checked_shooting`): (HERTZ_STEPS/2, HERTZ_STEPS) steps,
 #: then rows whose two results differ by more than FALLBACK_RTOL (relative) with
 #: (FALLBACK_STEPS/2, FALLBACK_STEPS), then "not_converged" (Q = NaN). Next to lift-off 200
 #: steps were off by up to 3e-5 (Barus, against the DOP853 reference; Roelands, against 3200
 #: steps) and 3200 by <= 5e-8 (bench/extensions_results.md); Barus rows start at the second
-#: level (the panel rows that fail are all next to lift-off)
+#: level (the panel rows that fail are all next to lift-off), Roelands rows at the first
 FALLBACK_STEPS = 3200
 FALLBACK_RTOL = 1e-6
 CHECKED_LEVELS = ((HERTZ_STEPS // 2, HERTZ_STEPS), (FALLBACK_STEPS // 2, FALLBACK_STEPS))
@@ -136,17 +139,17 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         (pieces no wider than SHORT_WIDTH × quad_width with SHORT_ORDER points).
     steps : int or None
         RK4 steps of the O-ring shooting across the Hertz sealing zone. None (default): the
-        Barus O-ring by the base engine's panel collocation in ψ (~4× faster than 200 steps;
-        error against an adaptive DOP853 shooting in bench/extensions_results.md; rows where
-        its Newton fails are shot with FALLBACK_STEPS steps, checked against half as many:
-        "not_converged" (Q = NaN) where the two differ by more than FALLBACK_RTOL), the
-        Roelands O-ring by shooting with HERTZ_STEPS steps checked against half as many (rows
-        where they differ by more than FALLBACK_RTOL again with FALLBACK_STEPS, then
-        "not_converged"); an integer: shooting with that many steps, unchecked (both laws).
+        O-ring by the base engine's panel collocation in ψ (Barus ~4× faster than 200 steps,
+        Roelands ~3×; error against an adaptive DOP853 shooting in
+        bench/extensions_results.md). Rows where its Newton fails are shot, checked against
+        half as many steps: Barus with FALLBACK_STEPS, Roelands with HERTZ_STEPS, then, where
+        the two differ by more than FALLBACK_RTOL, with FALLBACK_STEPS; "not_converged"
+        (Q = NaN) where they still differ. An integer: shooting with that many steps,
+        unchecked (both laws).
     viscosity : {"barus", "roelands"}
         Viscosity law (module docstring; :mod:`fastcontact.flow.piezoviscosity`). Roelands:
-        ln(η/η0) = ln(η0/η_∞)[(1 + (p_f - p_b)/p_r)^Z - 1], solved without the reduced
-        pressure (it does not apply).
+        ln(η/η0) = ln(η0/η_∞)[(1 + (p_f - p_b)/p_r)^Z - 1], its reduced pressure
+        tabulated (no closed-form inverse).
     roelands_z : array_like or None
         Roelands pressure–viscosity index Z [-] >= 0 (None: from ``alpha_pv``).
     roelands_p_r : float or None
@@ -505,8 +508,12 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
         if law is not None:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, law[0], law[1])]
             if steps is None:
-                k, ok = _checked_shooting(_shooter(_hertz_kernel_r, tab, sc, HertzRows(*sub),
-                                                   law[2]), k.size, CHECKED_LEVELS)
+                k, ok = _roelands_hertz_k(tables, theory, *sub, law[2])
+                if not np.all(ok):   # Newton failed (steep laws next to lift-off): shooting
+                    bad = np.flatnonzero(~ok)
+                    k[bad], ok[bad] = _checked_shooting(
+                        _shooter(_hertz_kernel_r, tab, sc, HertzRows(*(x[bad] for x in sub)),
+                                 law[2]), bad.size, CHECKED_LEVELS)
             else:
                 none = np.full(k.size, np.nan)
                 _hertz_kernel_r(tab, sc, HertzRows(*sub), law[2], int(steps), none, none, k, ok,
@@ -589,6 +596,26 @@ def _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha):
         psia = np.where(alpha > 0.0, -np.expm1(-alpha * dp) / np.where(alpha > 0.0, alpha, 1.0),
                         dp)
         k = psia / (a * out.W)
+    ok = (out.status != _panels.ST_NEWTON_FAILED) & (out.status != _panels.ST_NO_ZONE) \
+        & np.isfinite(k) & (k > 0.0)
+    return np.where(ok, k, np.nan), ok
+
+
+def _roelands_hertz_k(tables, theory, E, pH, a, pa, pb, A, Z, pr):
+    """(k = 12 η0 q/h³ [Pa/m], converged) of Roelands O-rings (p_a <= p_H, Δp > 0) by the same
+    panel collocation as the Barus ones (:func:`_barus_hertz_k`), in the reduced pressure
+    ψ = ∫η0/η dp tabulated per row (:mod:`._roelands_psi`): k = ψ_a/(a W)."""
+    o = solver_options({"tol": BARUS_PANEL_TOL, "max_panels": 256})
+    prn = np.ascontiguousarray(pr / E, dtype=np.float64)
+    vis = np.ascontiguousarray(np.column_stack((A, Z, prn)))
+    out = solve_profile_rows(seal_context(tables, theory), o, 0, np.zeros(2), np.zeros(2),
+                             pH / E, pa / E, pb / E, np.arange(E.size),
+                             pa >= (1.0 - NEAR_LIFT_OFF) * pH, None, vis)
+    psia = np.empty(E.size)
+    psi_drops(np.ascontiguousarray(A), np.ascontiguousarray(Z), prn,
+              np.ascontiguousarray((pa - pb) / E), psia)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = E * psia / (a * out.W)
     ok = (out.status != _panels.ST_NEWTON_FAILED) & (out.status != _panels.ST_NO_ZONE) \
         & np.isfinite(k) & (k > 0.0)
     return np.where(ok, k, np.nan), ok

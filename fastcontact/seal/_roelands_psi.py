@@ -1,0 +1,142 @@
+"""The reduced pressure of a Roelands fluid, ψ(π) = ∫_0^π η0/η(π') dπ', and its inverse
+(private; the soft-seal solver's O-ring with a Roelands fluid, :mod:`._panels`).
+
+With η(p) the flux through a seal is constant in ψ, not in the fluid pressure (docs/theory/
+extensions.md §2): for Barus ψ has the closed form (1 - e^{-α̃π})/α̃ and its inverse
+-ln(1 - α̃ψ)/α̃. For Roelands, ln(η/η0) = A[(1 + π/π_r)^Z - 1] (C.J.A. Roelands, PhD thesis,
+TU Delft (1966); B.J. Hamrock and D. Dowson, Ball Bearing Lubrication, Wiley (1981), eq. 4.5),
+ψ is an incomplete gamma function with no closed-form inverse, so a solve tabulates it once:
+in u = ln(1 + π/π_r) (π = π_r(e^u - 1)) the integrand
+
+    dψ/du = g(u) = π_r exp(u - A(e^{Zu} - 1)),   d²ψ/du² = g(u)(1 - A Z e^{Zu}),
+
+is an entire function; the table holds ψ, g and dg/du at nodes of width h <= PSI_CELL (and
+<= PSI_STEEP/(1 + A Z e^{Z u_max}) where the law is steep), ψ by 8-point Gauss–Legendre per
+cell, and ψ between nodes is their quintic Hermite interpolant. The table reaches PSI_REACH
+times the pressure drop; beyond it ψ continues linearly with its end slope, below π = 0 as
+ψ = π (η = η0 below the outlet pressure). The inverse π(ψ) is Newton with the exact
+dψ/dπ = η0/η: ψ is concave, so from π = ψ (<= the root, since η >= η0) the iterates rise
+monotonically to the root.
+
+All pressures are reduced by E* (π = p/E*, π_r = p_r/E*, ψ in the same units).
+"""
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from ..flow.piezoviscosity import ln_roelands
+from ..kernels.hermite import quintic_unit
+from ..kernels.quadrature import gauss_legendre
+
+__all__ = ["PsiTable", "psi_table", "no_psi_table", "psi_of", "fluid_of", "eta_ratio",
+           "psi_drops", "PSI_CELL", "PSI_STEEP", "PSI_REACH"]
+
+#: a table of ψ(π): the law (A, Z, π_r), the node width h in u = ln(1 + π/π_r), the values
+#: y = ψ, g = dψ/du and s = d²ψ/du² at the nodes u_k = k h (size 0: no Roelands fluid)
+PsiTable = namedtuple("PsiTable", "A Z pr h y g s")
+#: largest node width in u
+PSI_CELL = 0.01
+#: node width where the law is steep: h <= PSI_STEEP/(1 + A Z e^{Z u_max}) (the scale on which
+#: g changes is 1/(A Z e^{Zu}))
+PSI_STEEP = 0.1
+#: the table covers π up to PSI_REACH × the pressure drop (Newton's trial states overshoot)
+PSI_REACH = 1.5
+#: most nodes of one table
+PSI_MAX_NODES = 20000
+_GLX, _GLW = gauss_legendre(8)
+
+
+@njit(cache=True)
+def _g(u, A, Z, pr):
+    """dψ/du at u = ln(1 + π/π_r)."""
+    return pr * math.exp(u - A * math.expm1(Z * u))
+
+
+@njit(cache=True)
+def psi_table(A, Z, pr, dpi):
+    """The :data:`PsiTable` of the law (A, Z, π_r) for fluid pressures 0 .. PSI_REACH·dpi
+    above the outlet (reduced)."""
+    umax = math.log1p(PSI_REACH * max(dpi, 0.0) / pr)
+    steep = PSI_STEEP / (1.0 + A * Z * math.exp(Z * umax))
+    n = min(PSI_MAX_NODES, max(1, int(math.ceil(umax / min(PSI_CELL, steep)))))
+    h = umax / n if umax > 0.0 else 1.0
+    y = np.empty(n + 1)
+    g = np.empty(n + 1)
+    s = np.empty(n + 1)
+    y[0] = 0.0
+    for k in range(n + 1):
+        u = k * h
+        gk = _g(u, A, Z, pr)
+        g[k] = gk
+        s[k] = gk * (1.0 - A * Z * math.exp(Z * u))
+        if k < n:
+            acc = 0.0
+            for j in range(_GLX.size):
+                acc += _GLW[j] * _g(u + 0.5 * h * (_GLX[j] + 1.0), A, Z, pr)
+            y[k + 1] = y[k] + 0.5 * h * acc
+    return PsiTable(A, Z, pr, h, y, g, s)
+
+
+@njit(cache=True)
+def no_psi_table():
+    """An empty :data:`PsiTable` (no Roelands fluid)."""
+    e = np.empty(0)
+    return PsiTable(0.0, 0.0, 1.0, 1.0, e, e, e)
+
+
+@njit(cache=True, inline="always")
+def eta_ratio(rt, pi):
+    """η/η0 at the fluid pressure π above the outlet (1 at or below it)."""
+    if pi <= 0.0:
+        return 1.0
+    return math.exp(ln_roelands(pi, rt.A, rt.Z, rt.pr))
+
+
+@njit(cache=True)
+def psi_of(rt, pi):
+    """ψ(π) [reduced] from the table ``rt`` (quintic Hermite in u; linear beyond its end)."""
+    if pi <= 0.0:
+        return pi
+    n = rt.y.size - 1
+    u = math.log1p(pi / rt.pr)
+    t = u / rt.h
+    k = int(t)
+    if k >= n:
+        u_end = n * rt.h
+        pi_end = rt.pr * math.expm1(u_end)
+        return rt.y[n] + (pi - pi_end) * rt.g[n] / (rt.pr * math.exp(u_end))
+    return quintic_unit(t - k, rt.h, rt.y[k], rt.g[k], rt.s[k], rt.y[k + 1], rt.g[k + 1],
+                        rt.s[k + 1])[0]
+
+
+@njit(cache=True)
+def fluid_of(rt, psi):
+    """π(ψ): the fluid pressure above the outlet whose ψ is ``psi`` (Newton, module
+    docstring; to a step of 1e-15 π)."""
+    if psi <= 0.0:
+        return psi
+    n = rt.y.size - 1
+    if psi >= rt.y[n]:  # beyond the table: its linear continuation
+        u_end = n * rt.h
+        slope = rt.g[n] / (rt.pr * math.exp(u_end))
+        pi_end = rt.pr * math.expm1(u_end)
+        return pi_end + (psi - rt.y[n]) / slope if slope > 0.0 else pi_end
+    pi = psi
+    for _ in range(200):
+        step = (psi_of(rt, pi) - psi) * eta_ratio(rt, pi)
+        pi -= step
+        if abs(step) <= 1e-15 * pi:
+            break
+    return pi
+
+
+@njit(cache=True)
+def psi_drops(A, Z, pr, dpi, out):
+    """ψ(Δπ) per row (the laws A, Z, π_r and drops Δπ, reduced) into ``out``, from the same
+    table the solver builds for the row."""
+    for i in range(dpi.size):
+        out[i] = psi_of(psi_table(A[i], Z[i], pr[i], dpi[i]), dpi[i])
