@@ -37,6 +37,7 @@ import statistics
 import sys
 import time
 from pathlib import Path
+from unittest import mock
 
 import numpy as np
 
@@ -51,6 +52,7 @@ from fastcontact.flow.anisotropy import (directional_sigma_bar,  # noqa: E402
                                          precompute_directional)
 from fastcontact.flow.conductivity import conductivity  # noqa: E402
 from fastcontact.seal import seal_leak  # noqa: E402
+from fastcontact.seal import viscosity as viscosity_mod  # noqa: E402
 from fastcontact.seal.viscosity import SWEEP_TABLE_ROWS, seal_leak_piezo  # noqa: E402
 from fastcontact.squeeze import squeeze_out  # noqa: E402
 from fastcontact.figures.asperity_figures import plot_asperity_tstar  # noqa: E402
@@ -439,19 +441,31 @@ def bench_roelands(lines, summary, tables, quick):
         lines.append(f"| {steps} | {e:.1e} | {1e3 * dt / dps.size:.3f} |")
         if steps == 200:
             eh200, th200 = e, dt
-    # the default: 100/200 steps checked, rows that disagree by > FALLBACK_RTOL again at
-    # 1600/3200; its error also next to lift-off (p_a = p_H(1 - 1e-6)), against 12800 steps
-    # (the DOP853 reference is off by up to 8e-6 there, tests/test_ext_roelands.py)
+    # the default: the panel collocation in the tabulated ψ (rows whose Newton fails: the
+    # checked shooting, 100/200 steps, rows that disagree by > FALLBACK_RTOL again at
+    # 1600/3200, the previous default, timed here alone as the baseline); its error also next
+    # to lift-off (p_a = p_H(1 - 1e-6)), against 12800 steps (the DOP853 reference is off by
+    # up to 8e-6 there, tests/test_ext_roelands.py)
     rkw = dict(profile="hertz", R=R, f_N=fN, L_y=Ly, E_star=E, eta=ETA, alpha_pv=0.0,
                theory="emt", viscosity="roelands", roelands_z=z, roelands_p_r=1 / c)
     e_def = max(abs(seal_leak_piezo(tables, dp=dp, **rkw).Q[0] / q - 1) for dp, q in refs.items())
     t_def = timed(lambda: seal_leak_piezo(tables, dp=dps, **rkw), 3)
+
+    def all_shot(tables, theory, E, *rest):   # every row to the checked shooting
+        return np.full(E.size, np.nan), np.zeros(E.size, dtype=bool)
+    with mock.patch.object(viscosity_mod, "_roelands_hertz_k", all_shot):
+        e_chk = max(abs(seal_leak_piezo(tables, dp=dp, **rkw).Q[0] / q - 1)
+                    for dp, q in refs.items())
+        t_chk = timed(lambda: seal_leak_piezo(tables, dp=dps, **rkw), 3)
     near = [pH * (1 - 1e-3), pH * (1 - 1e-4), pH * (1 - 1e-6)]
     fine = seal_leak_piezo(tables, dp=near, steps=12800, **rkw).Q.to_numpy()
     e_near = {st: float(np.nanmax(np.abs(seal_leak_piezo(tables, dp=near, **kw_st, **rkw)
                                          .Q.to_numpy() / fine - 1)))
               for st, kw_st in (("default", {}), (200, {"steps": 200}))}
-    lines.append(f"| default (checked) | {e_def:.1e} | {1e3 * t_def / dps.size:.3f} |")
+    lines.append(f"| default (panel collocation in ψ) | {e_def:.1e} | "
+                 f"{1e3 * t_def / dps.size:.3f} |")
+    lines.append(f"| checked shooting (its fallback; the default before) | {e_chk:.1e} | "
+                 f"{1e3 * t_chk / dps.size:.3f} |")
     lines += ["", f"Next to lift-off (p_a = p_H(1 − ε), ε = 1e-3, 1e-4, 1e-6) against 12800 steps: "
               f"default {e_near['default']:.1e}, 200 steps {e_near[200]:.1e}."]
     tb = timed(lambda: seal_leak(tables, profile="hertz", R=R, f_N=fN, dp=dps, L_y=Ly, E_star=E,
@@ -466,7 +480,8 @@ def bench_roelands(lines, summary, tables, quick):
     lines += ["", f"Flat ring (Δp sweep of one seal) {n / tu:.3g} rows/s (base {n / tub:.3g} "
               f"rows/s); O-ring "
               f"{dps.size / th200:.3g} rows/s at 200 steps, {dps.size / t_def:.3g} rows/s by the "
-              f"default checked shooting (base {dps.size / tb:.3g} rows/s).", ""]
+              f"default collocation, {dps.size / t_chk:.3g} by the checked shooting (base "
+              f"{dps.size / tb:.3g} rows/s).", ""]
     # where it matters: steel face seal sealing oil, Roelands vs Barus at the same α0
     face = fc.SelfAffinePSD(h_rms=0.2e-6, hurst=0.8, q0=1e4, q1=1e8)
     th = fc.precompute(face, theories=("emt",))
@@ -487,11 +502,12 @@ def bench_roelands(lines, summary, tables, quick):
               "is smaller. No reduced pressure exists in closed form for it: the flat ring uses "
               "the separated integral, the O-ring the panel collocation in a tabulated ψ.", ""]
     summary.append(("Roelands seal", f"flat ring {eu:.1e} (solve_bvp); O-ring {eh200:.1e} at "
-                    f"200 steps, default (checked) {e_def:.1e} (DOP853); next to lift-off "
+                    f"200 steps, default (collocation in ψ) {e_def:.1e} (DOP853); next to "
+                    f"lift-off "
                     f"default {e_near['default']:.1e}, 200 steps {e_near[200]:.1e} (vs 12800 steps)",
                     f"flat {n / tu:.3g} rows/s (base {n / tub:.3g}); O-ring default "
-                    f"{dps.size / t_def:.3g} rows/s, 200 steps {dps.size / th200:.3g} (base "
-                    f"{dps.size / tb:.3g})"))
+                    f"{dps.size / t_def:.3g} rows/s (checked shooting {dps.size / t_chk:.3g}), "
+                    f"200 steps {dps.size / th200:.3g} (base {dps.size / tb:.3g})"))
 
 
 def bench_aniso_tables(lines, summary, quick):
