@@ -23,6 +23,15 @@ with q = (ψ_a/W) h³E*/(12η0ℓ). The Newton matrix is the constant-viscosity 
 coupling multiplied by P'(ψ_i) = 1/(1 − α̃ ψ_i) (exact; α̃ = 0 is the base solver, bit for
 bit). The contact pressure c = p0 − p_f is still the unknown, so σ̄ sees the fluid
 pressure's feedback exactly as in the base engine.
+
+Roelands fluid (zone field ``vis`` = (A, Z, π_r), A > 0): ψ = ∫η0/η dπ is tabulated per solve
+(:mod:`._roelands_psi`) and has no closed-form inverse, so the residual is written in ψ and
+scaled back to a pressure,
+
+    F_i = (ψ(π_f,i) − ψ_a R̃_i / W) η(π_f,i)/η0,   π_f,i = (p0_i − p_b) − c_i,
+
+the same root, and to first order in F the Barus form above; the Newton matrix is the
+constant-viscosity one with row i's coupling multiplied by η(π_f,i)/η0.
 """
 from __future__ import annotations
 
