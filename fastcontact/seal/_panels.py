@@ -43,7 +43,7 @@ from numba import njit, prange
 from ._mesh import (array_zone, geometry, interp_series, panel_series, remaining_fraction,
                     solve_small, zone_params)
 from ._panel_records import Mesh, State, Work, Zone, _work
-from ._roelands_psi import eta_ratio, fluid_of, no_psi_table, psi_of, psi_table
+from ._roelands_psi import eta_ratio, fluid_of, no_psi_table, psi_eta, psi_of, psi_table
 from ._sigma import sig_d
 
 __all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "ST_OK", "ST_NOT_REFINED",
@@ -169,8 +169,8 @@ def _resid(tab, sc, rule, st, dxi, eb, dpi, al, rt, pan, P):
     roel = rt.y.size > 0
     for i in range(N):
         if roel:
-            pf = eb[i] - c[i]
-            F[i] = (psi_of(rt, pf) - dpi * Rt[i] / W) * eta_ratio(rt, pf)
+            ps, er = psi_eta(rt, eb[i] - c[i])
+            F[i] = (ps - dpi * Rt[i] / W) * er
         elif al == 0.0:
             F[i] = eb[i] - c[i] - dpi * Rt[i] / W
         else:

@@ -32,7 +32,7 @@ from ..flow.piezoviscosity import ln_roelands
 from ..kernels.hermite import quintic_unit
 from ..kernels.quadrature import gauss_legendre
 
-__all__ = ["PsiTable", "psi_table", "no_psi_table", "psi_of", "fluid_of", "eta_ratio",
+__all__ = ["PsiTable", "psi_table", "no_psi_table", "psi_of", "psi_eta", "fluid_of", "eta_ratio",
            "psi_drops", "PSI_CELL", "PSI_STEEP", "PSI_REACH"]
 
 #: a table of ψ(π): the law (A, Z, π_r), the node width h in u = ln(1 + π/π_r), the values
@@ -96,13 +96,10 @@ def eta_ratio(rt, pi):
     return math.exp(ln_roelands(pi, rt.A, rt.Z, rt.pr))
 
 
-@njit(cache=True)
-def psi_of(rt, pi):
-    """ψ(π) [reduced] from the table ``rt`` (quintic Hermite in u; linear beyond its end)."""
-    if pi <= 0.0:
-        return pi
+@njit(cache=True, inline="always")
+def _psi_at(rt, pi, u):
+    """ψ at π > 0 with u = ln(1 + π/π_r) given."""
     n = rt.y.size - 1
-    u = math.log1p(pi / rt.pr)
     t = u / rt.h
     k = int(t)
     if k >= n:
@@ -111,6 +108,23 @@ def psi_of(rt, pi):
         return rt.y[n] + (pi - pi_end) * rt.g[n] / (rt.pr * math.exp(u_end))
     return quintic_unit(t - k, rt.h, rt.y[k], rt.g[k], rt.s[k], rt.y[k + 1], rt.g[k + 1],
                         rt.s[k + 1])[0]
+
+
+@njit(cache=True)
+def psi_of(rt, pi):
+    """ψ(π) [reduced] from the table ``rt`` (quintic Hermite in u; linear beyond its end)."""
+    if pi <= 0.0:
+        return pi
+    return _psi_at(rt, pi, math.log1p(pi / rt.pr))
+
+
+@njit(cache=True)
+def psi_eta(rt, pi):
+    """(ψ(π), η/η0 at π): :func:`psi_of` and :func:`eta_ratio` sharing u = ln(1 + π/π_r)."""
+    if pi <= 0.0:
+        return pi, 1.0
+    u = math.log1p(pi / rt.pr)
+    return _psi_at(rt, pi, u), math.exp(rt.A * math.expm1(rt.Z * u))
 
 
 @njit(cache=True)
@@ -127,7 +141,8 @@ def fluid_of(rt, psi):
         return pi_end + (psi - rt.y[n]) / slope if slope > 0.0 else pi_end
     pi = psi
     for _ in range(200):
-        step = (psi_of(rt, pi) - psi) * eta_ratio(rt, pi)
+        ps, er = psi_eta(rt, pi)
+        step = (ps - psi) * er
         pi -= step
         if abs(step) <= 1e-15 * pi:
             break
