@@ -450,6 +450,51 @@ def test_seal_hertz_panels_random(tables, theory):
         assert abs(got.Q[0] / ref - 1) < 2e-7, (j, got.Q[0], ref)
 
 
+@pytest.mark.parametrize("law", ["barus", "roelands"])
+def test_seal_hertz_sweep_chains_match_single_rows(tables, law, monkeypatch):
+    """A batch of O-rings is solved in chains (rows sharing p_H, p_b and the fluid, rising in
+    p_a; each row's Newton started on the previous row's solution). A shuffled batch of two
+    O-rings' Δp sweeps (up to 0.98 p_H, and next to lift-off) equals each row solved on its
+    own (a batch of one: a cold solve) within 1e-9 (measured <= 3.4e-10; that row is 2.8e-10
+    from the DOP853 reference, its cold solve 6.2e-10), and chains of more than one row did
+    run; three rows also against the DOP853 reference (within 3e-8; the Barus one of
+    tests/reference/ext_reynolds.py, Roelands' of ext_roelands.py)."""
+    from fastcontact.seal import context
+    from reference.ext_roelands import hertz_shoot as hertz_shoot_r
+    from reference.ext_roelands import roelands
+
+    spied = []
+    orig = context._panels.solve_rows_chained
+
+    def spy(*args):
+        spied.append(np.diff(args[-2]).max())
+        return orig(*args)
+    monkeypatch.setattr(context._panels, "solve_rows_chained", spy)
+    rows = []
+    for R, f_N in ((1e-3, 3.0), (2e-3, 5.0)):
+        a = math.sqrt(4 * f_N * R / (math.pi * E_STAR))
+        pH = 2 * f_N / (math.pi * a)
+        for frac in np.concatenate((np.linspace(0.02, 0.98, 40), [1 - 1e-4, 1 - 1e-6])):
+            rows.append((R, f_N, a, pH, frac * pH))
+    rows = [rows[k] for k in np.random.default_rng(3).permutation(len(rows))]
+    R, f_N, a, pH, dp = (np.array(c) for c in zip(*rows))
+    kw = dict(profile="hertz", L_y=L_Y, E_star=E_STAR, eta=ETA, theory="emt")
+    kw.update(dict(alpha_pv=1e-5) if law == "barus" else
+              dict(alpha_pv=0.0, viscosity="roelands", roelands_z=0.6, roelands_p_r=1e5))
+    batch = seal_leak_piezo(tables, R=R, f_N=f_N, dp=dp, **kw)
+    assert (batch.status == "ok").all() and max(spied) > 1
+    for k in range(dp.size):
+        one = seal_leak_piezo(tables, R=R[k], f_N=f_N[k], dp=dp[k], **kw)
+        assert abs(batch.Q[k] / one.Q[0] - 1) < 1e-9, (k, batch.Q[k] / one.Q[0] - 1)
+    for k in np.flatnonzero(dp <= 0.98 * pH)[:3]:
+        if law == "barus":
+            ref = hertz_shoot(_sigma(tables, "emt"), pH[k], a[k], dp[k], 0.0, 1e-5)
+        else:
+            ref = hertz_shoot_r(_sigma(tables, "emt"), pH[k], a[k], dp[k], 0.0,
+                                roelands(ETA, 0.6, 1e-5))
+        assert abs(batch.Q[k] / (ref * L_Y) - 1) < 3e-8, (k, batch.Q[k] / (ref * L_Y) - 1)
+
+
 def test_seal_hertz_lift_off_equality_and_shooting(tables):
     """At the lift-off equality p_a = p_H the panel solve (tolerance 1e-9 there) gives the
     finite limit, flagged lift_off, continuous with p_a a relative 1e-9 below it (Q varies

@@ -46,7 +46,8 @@ from ._panel_records import Mesh, State, Work, Zone, _work
 from ._roelands_psi import eta_ratio, fluid_of, no_psi_table, psi_eta, psi_of, psi_table
 from ._sigma import sig_d
 
-__all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "ST_OK", "ST_NOT_REFINED",
+__all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "solve_rows_chained", "ST_OK",
+           "ST_NOT_REFINED",
            "ST_NEWTON_FAILED", "ST_NO_ZONE", "Zone", "State", "Work", "Mesh"]
 
 #: status codes of solve_case
@@ -582,3 +583,51 @@ def solve_rows(tab, sc, rule, kind, xg, p0n, amp, pia, pib, al, vis, rows, out):
         W, st, P, est, xs, xe = solve_row(tab, sc, rule, kind, xg, p0n, amp[i], pia[i], pib[i],
                                           al[i], vis[i], mesh)
         _store_row(out, i, W, st, P, est, xs, xe)
+
+
+@njit(cache=True, parallel=True)
+def solve_rows_chained(tab, sc, rule, xg, p0n, amp, pia, pib, al, vis, rows, starts, out):
+    """Hertz soft seals (kind 0) as :func:`solve_rows`, in chains: rows[starts[c]:starts[c+1]]
+    share π_H, π_b and the fluid and rise in π_a (a Δp sweep of one O-ring). A chain's first
+    row is solved cold (:func:`solve_robust`); each later row starts its Newton on the
+    previous row's final mesh and remaining fraction s = R̃/W (the continuation inputs of
+    :func:`solve_case`, as :func:`solve_robust`'s steps in p_a), and is solved cold where that
+    fails. The result meets the same tolerance either way (W within ~1e-11 of a cold solve);
+    it can differ from it in the last digits, by the chain the row is in."""
+    PMAX, n = rule.PMAX, rule.n
+    for c in prange(starts.size - 1):
+        mesh = Mesh(np.empty(PMAX + 1), np.empty(PMAX * n), np.empty(PMAX * n))
+        pan_prev = np.empty(PMAX + 1)
+        s_prev = np.empty(PMAX * n)
+        coef = np.empty((PMAX, n))
+        after = np.empty(PMAX)
+        Pk = np.empty(n + 1)
+        gp = np.empty(3)
+        base1 = np.empty(1)
+        nil = np.empty(0)
+        P_prev = 0
+        for j in range(starts[c], starts[c + 1]):
+            i = rows[j]
+            st = ST_NEWTON_FAILED
+            W = 0.0
+            P = 0
+            est = 0.0
+            base1[0] = amp[i]
+            if P_prev > 0 and zone_params(0, base1, xg, p0n, pia[i], pib[i], gp):
+                W, st, P, est, _its = solve_case(
+                    tab, sc, rule, rule.tol, rule.maxit,
+                    Zone(0, gp, xg, p0n, pia[i], pib[i], al[i], vis[i]), mesh, P_prev, pan_prev,
+                    s_prev, nil)
+            if st == ST_NEWTON_FAILED:
+                W, st, P, est, _xs, _xe = solve_row(tab, sc, rule, 0, xg, p0n, amp[i], pia[i],
+                                                    pib[i], al[i], vis[i], mesh)
+            _store_row(out, i, W, st, P, est, math.nan, math.nan)
+            P_prev = 0
+            if st != ST_NEWTON_FAILED and st != ST_NO_ZONE and W > 0.0 and P > 0:
+                # the next row's start: this one's mesh and remaining fraction at its nodes
+                panel_series(mesh.r, mesh.pan, P, n, rule.Lp, coef, after)
+                _series_at_nodes(mesh.pan, P, rule, mesh.pan, P, coef, after, W, Pk, True,
+                                 s_prev)
+                for p in range(P + 1):
+                    pan_prev[p] = mesh.pan[p]
+                P_prev = P

@@ -376,12 +376,18 @@ def panel_rule(o, tol=None, max_panels=None):
                      float(o["tol"] if tol is None else tol), int(o["max_newton"]), z, w, At, Lp)
 
 
-def solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, near, al=None, vis=None):
+def solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, near, al=None, vis=None,
+                       chain=False):
     """The soft-seal solver (:func:`._panels.solve_rows`) on rows ``idx`` into a fresh
     :class:`RowsOut`: rows with ``near`` (at or within NEAR_LIFT_OFF below lift-off) at the
     panel tolerance min(tol, EQUALITY_TOL) and at least 256 panels, the others with the
     options ``o`` as they are; ``al`` the rows' reduced Barus α̃ = α E* (None: 0, a constant
-    viscosity), ``vis`` (rows, 3) their Roelands law (A, Z, π_r = p_r/E*) (None: none)."""
+    viscosity), ``vis`` (rows, 3) their Roelands law (A, Z, π_r = p_r/E*) (None: none).
+    ``chain`` (Hertz rows, kind 0): rows sharing π_H, π_b and the fluid are solved in chains of
+    rising π_a, each row started on the previous one's solution
+    (:func:`._panels.solve_rows_chained`, :func:`_chains`; W within ~1e-10 of a cold solve).
+    Not the rows next to lift-off: Q has a square-root limit there and converges slowly in
+    the tolerance, and a warm start left one 3e-8 from its cold solve."""
     out = RowsOut.empty(amp.size)
     al = np.zeros(amp.size) if al is None else np.ascontiguousarray(al, dtype=np.float64)
     vis = np.zeros((amp.size, 0)) if vis is None else np.ascontiguousarray(vis, dtype=np.float64)
@@ -390,6 +396,39 @@ def solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, near, al=None, 
             continue
         rule = panel_rule(o, tol=min(o["tol"], EQUALITY_TOL) if nr else None,
                           max_panels=max(o["max_panels"], 256) if nr else None)
+        if chain and kind == 0 and sel.size > 1 and not nr:  # not next to lift-off (below)
+            order, starts = _chains(sel, amp, pia, pib, al, vis)
+            _panels.solve_rows_chained(sc.tab, sc.rec, rule, xg, p0n, amp, pia, pib, al, vis,
+                                       order, starts, out)
+            continue
         _panels.solve_rows(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pia, pib, al, vis,
                            np.ascontiguousarray(sel, dtype=np.int64), out)
     return out
+
+
+#: most rows per chain of :func:`._panels.solve_rows_chained`; a batch is cut into about one
+#: chain per thread (chains run in parallel; each chain's first row is solved cold), no
+#: shorter than CHAIN_MIN rows
+CHAIN_MAX = 256
+CHAIN_MIN = 8
+
+
+def _chains(sel, amp, pia, pib, al, vis):
+    """(rows, starts) of :func:`._panels.solve_rows_chained`: the rows ``sel`` sorted by
+    π_H, π_b, α̃, the Roelands law and then π_a, cut where any of the first four changes and
+    every L rows, L = sel.size / threads within [CHAIN_MIN, CHAIN_MAX]."""
+    from numba import get_num_threads
+    L = min(CHAIN_MAX, max(CHAIN_MIN, -(-sel.size // get_num_threads())))
+    keys = [amp[sel], pib[sel], al[sel]] + [vis[sel, k] for k in range(vis.shape[1])]
+    order = np.lexsort([pia[sel]] + keys[::-1])
+    new = np.zeros(sel.size, dtype=bool)
+    new[0] = True
+    for k in keys:
+        ks = k[order]
+        new[1:] |= ks[1:] != ks[:-1]
+    run = np.cumsum(new) - 1
+    first = np.flatnonzero(new)
+    pos = np.arange(sel.size) - first[run]
+    starts = np.flatnonzero(new | (pos % L == 0))
+    return (np.ascontiguousarray(sel[order], dtype=np.int64),
+            np.append(starts, sel.size).astype(np.int64))

@@ -590,7 +590,7 @@ def _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha):
     o = solver_options({"tol": BARUS_PANEL_TOL, "max_panels": 256})
     out = solve_profile_rows(seal_context(tables, theory), o, 0, np.zeros(2), np.zeros(2),
                              pH / E, pa / E, pb / E, np.arange(E.size),
-                             pa >= (1.0 - NEAR_LIFT_OFF) * pH, alpha * E)
+                             pa >= (1.0 - NEAR_LIFT_OFF) * pH, alpha * E, chain=True)
     dp = pa - pb
     with np.errstate(divide="ignore", invalid="ignore"):
         psia = np.where(alpha > 0.0, -np.expm1(-alpha * dp) / np.where(alpha > 0.0, alpha, 1.0),
@@ -610,7 +610,7 @@ def _roelands_hertz_k(tables, theory, E, pH, a, pa, pb, A, Z, pr):
     vis = np.ascontiguousarray(np.column_stack((A, Z, prn)))
     out = solve_profile_rows(seal_context(tables, theory), o, 0, np.zeros(2), np.zeros(2),
                              pH / E, pa / E, pb / E, np.arange(E.size),
-                             pa >= (1.0 - NEAR_LIFT_OFF) * pH, None, vis)
+                             pa >= (1.0 - NEAR_LIFT_OFF) * pH, None, vis, chain=True)
     psia = np.empty(E.size)
     psi_drops(np.ascontiguousarray(A), np.ascontiguousarray(Z), prn,
               np.ascontiguousarray((pa - pb) / E), psia)
