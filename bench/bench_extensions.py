@@ -68,6 +68,13 @@ SURFACE = dict(h_rms=5e-6, hurst=0.8, q0=1e4, q1=1e8)
 E, ETA = 1e7, 1e-3
 
 
+def _unchained(solve_profile_rows):
+    """``solve_profile_rows`` with its chains along a sweep switched off (every row cold)."""
+    def cold(*args, chain=False, **kwargs):
+        return solve_profile_rows(*args, **kwargs)
+    return cold
+
+
 def timed(fn, repeats=5):
     ts = []
     for _ in range(repeats):
@@ -185,6 +192,15 @@ def bench_seal(lines, tables, quick, summary):
             e_pan, t_pan = err, dt
         if steps == 200:
             t200 = dt
+    # the default without the chains along the sweep (every row a cold panel solve), the
+    # baseline of the chains in the same run
+    cold_rows = _unchained(viscosity_mod.solve_profile_rows)
+    with mock.patch.object(viscosity_mod, "solve_profile_rows", cold_rows):
+        t_cold = timed(lambda: seal_leak_piezo(tables, profile="hertz", R=R, f_N=fN, dp=dps,
+                                               L_y=Ly, E_star=E, eta=ETA, alpha_pv=3e-5,
+                                               theory="emt"), 3)
+    lines.append(f"| panels, every row cold (no chains along the sweep) | {e_pan:.1e} | "
+                 f"{1e3 * t_cold / dps.size:.3f} |")
     tb = timed(lambda: seal_leak(tables, profile="hertz", R=R, f_N=fN, dp=dps, L_y=Ly, E_star=E,
                                  eta=ETA, theory="emt"), 3)
     tbd = timed(lambda: seal_leak(tables, profile="hertz", R=R, f_N=fN, dp=dps, L_y=Ly,
@@ -210,7 +226,8 @@ def bench_seal(lines, tables, quick, summary):
               f"of its run (the Roelands flat ring below); shorter ones add each row's piece to "
               f"the previous row's integral.", ""]
     summary.append(("Barus seal", f"O-ring {e_pan:.1e} by panels (DOP853 shooting)",
-                    f"O-ring {dps.size / t_pan:.3g} rows/s (200-step shooting "
+                    f"O-ring {dps.size / t_pan:.3g} rows/s (rows cold, no chains "
+                    f"{dps.size / t_cold:.3g}; 200-step shooting "
                     f"{dps.size / t200:.3g}; base table {dps.size / tb:.3g}, base direct "
                     f"{dps.size / tbd:.3g}); flat ring, Δp sweep "
                     f"{n / tu:.3g} rows/s (base {n / tub:.3g}), distinct p0 {n / tud:.3g}"))
