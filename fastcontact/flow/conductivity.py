@@ -31,7 +31,7 @@ from ..contact._kernels import PANEL, psd_kernel
 from ..kernels.balance import spread_order
 from ..kernels.quadrature import gauss_hermite, gauss_legendre
 from ..kernels.special import k_table
-from ._kernels import (EMT_MAX_PANELS, EMT_TOL, FAR_AREA, FAR_ORDER, EMTSpec,
+from ._kernels import (EMT_MAX_PANELS, EMT_TOL, FAR_AREA, FAR_MIN_TOL, FAR_ORDER, EMTSpec,
                        critical_junction_kernel, emt_kernel_warm)
 
 __all__ = ["THEORIES", "EMT_TOL", "check_theory", "check_emt_threshold", "check_anisotropy", "conductivity", "flow_factor", "sigma_bar",
@@ -207,9 +207,9 @@ def emt_sigma_bar_started(psd, pbar, start, nstart, *, gamma=1.0, tol=EMT_TOL, a
     quadrature in A started on given panels (a table build passes each new pressure the final
     partition of a neighbouring node: the splits that partition already made are not repeated,
     and the nodes they would discard are not computed). The result meets the same ``tol``.
-    With ``tol`` >= 1e-7 (a table's), u1 takes FAR_ORDER Gauss points per panel at pressures
-    with A(ζ1)/A0 < FAR_AREA × A_c (:data:`~fastcontact.flow._kernels.FAR_ORDER`: σ̄ within
-    7e-9 of the 10-point rule's there).
+    With ``tol`` >= FAR_MIN_TOL (1e-7, a table's), u1 takes FAR_ORDER Gauss points per panel
+    at pressures with A(ζ1)/A0 < FAR_AREA × A_c (:data:`~fastcontact.flow._kernels.FAR_ORDER`:
+    σ̄ within 7e-9 of the 10-point rule's there).
 
     Parameters
     ----------
@@ -229,8 +229,8 @@ def emt_sigma_bar_started(psd, pbar, start, nstart, *, gamma=1.0, tol=EMT_TOL, a
     ghx, ghw = gauss_hermite(GH_ORDER)
     glx, glw = gauss_legendre()
     threshold = check_emt_threshold(emt_threshold)
-    # a table's tolerance (>= 1e-7): fewer u1 points far from percolation (FAR_ORDER)
-    far = (FAR_AREA * threshold, *gauss_legendre(FAR_ORDER)) if tol >= 1e-7 else ()
+    # a table's tolerance: fewer u1 points far from percolation (FAR_ORDER)
+    far = (FAR_AREA * threshold, *gauss_legendre(FAR_ORDER)) if tol >= FAR_MIN_TOL else ()
     spec = EMTSpec(float(psd.h_rms), float(gamma), glx, glw, float(PANEL), bool(almqvist), ghx,
                    ghw, int(n_start), float(tol), threshold, *far)
     return _emt(psd_kernel(psd), pbar, spec, start, nstart)

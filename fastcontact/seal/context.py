@@ -421,14 +421,21 @@ def _chains(sel, amp, pia, pib, al, vis):
     L = min(CHAIN_MAX, max(CHAIN_MIN, -(-sel.size // get_num_threads())))
     keys = [amp[sel], pib[sel], al[sel]] + [vis[sel, k] for k in range(vis.shape[1])]
     order = np.lexsort([pia[sel]] + keys[::-1])
-    new = np.zeros(sel.size, dtype=bool)
-    new[0] = True
-    for k in keys:
-        ks = k[order]
-        new[1:] |= ks[1:] != ks[:-1]
+    new = new_runs(keys, order)
     run = np.cumsum(new) - 1
     first = np.flatnonzero(new)
     pos = np.arange(sel.size) - first[run]
     starts = np.flatnonzero(new | (pos % L == 0))
     return (np.ascontiguousarray(sel[order], dtype=np.int64),
             np.append(starts, sel.size).astype(np.int64))
+
+
+def new_runs(keys, order):
+    """For the rows in ``order`` (sorted by the keys): True where a row's keys differ from the
+    previous row's (and at the first row)."""
+    new = np.zeros(order.size, dtype=bool)
+    new[0] = True
+    for k in keys:
+        ks = k[order]
+        new[1:] |= ks[1:] != ks[:-1]
+    return new

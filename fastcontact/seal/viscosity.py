@@ -55,7 +55,8 @@ from ..flow.piezoviscosity import ROELANDS_ETA_INF, check_law, roelands_paramete
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from . import _panels
-from .context import NEAR_LIFT_OFF, seal_context, solve_profile_rows, solver_options
+from .context import (NEAR_LIFT_OFF, new_runs, seal_context, solve_profile_rows,
+                      solver_options)
 from ._piezo_kernels import (TAIL_CUT, HertzRows, Quad, RingCells, UniformRows, _cells_kernel,
                              _cells_rows, _hertz_kernel, _hertz_kernel_r, _uniform_sweep_kernel)
 from ._roelands_psi import psi_drops
@@ -399,23 +400,12 @@ def _run_tabled(tab, sc, sub, pr, quad, out, done):
         _table_rows(tab, sc, sub, None if whole else todo[order[f:e]], bc, quad, out, done)
 
 
-def _new_runs(keys, order):
-    """For the rows in ``order`` (sorted by the keys): True where a row's keys differ from the
-    previous row's (and at the first row)."""
-    new = np.zeros(order.size, dtype=bool)
-    new[0] = True
-    for k in keys:
-        ks = k[order]
-        new[1:] |= ks[1:] != ks[:-1]
-    return new
-
-
 def _shares(keys, n, sample=2048):
     """Whether rows seem to share an integrand: any two of ~``sample`` evenly spaced rows with
     equal keys (a cheap guess that spares a batch of distinct rings the sort; a miss only
     costs speed)."""
     smp = [k[::max(1, n // sample)] for k in keys]
-    return not _new_runs(smp, np.lexsort(smp[::-1])).all()
+    return not new_runs(smp, np.lexsort(smp[::-1])).all()
 
 
 def _runs(sub, by_pa=True):
@@ -430,7 +420,7 @@ def _runs(sub, by_pa=True):
         order = np.lexsort([pa] + keys[::-1]) if keys else np.argsort(pa, kind="stable")
     else:
         order = np.lexsort(keys[::-1]) if keys else np.arange(pa.size)
-    return order, _new_runs(keys, order)
+    return order, new_runs(keys, order)
 
 
 def _sweep_order(sub):
@@ -583,42 +573,40 @@ def _shooter(kernel, tab, sc, rows, *extra):
     return shoot
 
 
-def _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha):
-    """(k = 12 η0 q/h³ [Pa/m], converged) of Barus O-rings (p_a <= p_H, Δp > 0) by the base
-    seal engine's panel collocation in ψ (:mod:`._panels`, α̃ = α E*): k = ψ_a/(a W) with
-    ψ_a = (1 - e^{-αΔp})/α [Pa] and W the reduced resistance of the sealing zone."""
+def _panel_hertz_k(tables, theory, E, pH, a, pa, pb, psia, al=None, vis=None):
+    """(k = 12 η0 q/h³ [Pa/m], converged) of O-rings (p_a <= p_H, Δp > 0) by the base seal
+    engine's panel collocation in ψ (:mod:`._panels`, chained along Δp sweeps): k = ψ_a/(a W),
+    ψ_a [Pa] the fluid's reduced pressure drop, W the reduced resistance of the sealing zone;
+    ``al`` the Barus α̃ = α E* per row, ``vis`` (rows, 3) the Roelands law (A, Z, p_r/E*)."""
     o = solver_options({"tol": BARUS_PANEL_TOL, "max_panels": 256})
     out = solve_profile_rows(seal_context(tables, theory), o, 0, np.zeros(2), np.zeros(2),
                              pH / E, pa / E, pb / E, np.arange(E.size),
-                             pa >= (1.0 - NEAR_LIFT_OFF) * pH, alpha * E, chain=True)
-    dp = pa - pb
+                             pa >= (1.0 - NEAR_LIFT_OFF) * pH, al, vis, chain=True)
     with np.errstate(divide="ignore", invalid="ignore"):
-        psia = np.where(alpha > 0.0, -np.expm1(-alpha * dp) / np.where(alpha > 0.0, alpha, 1.0),
-                        dp)
         k = psia / (a * out.W)
     ok = (out.status != _panels.ST_NEWTON_FAILED) & (out.status != _panels.ST_NO_ZONE) \
         & np.isfinite(k) & (k > 0.0)
     return np.where(ok, k, np.nan), ok
 
 
+def _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha):
+    """:func:`_panel_hertz_k` of Barus O-rings (α̃ = α E*), ψ_a = (1 - e^{-αΔp})/α [Pa]."""
+    dp = pa - pb
+    with np.errstate(divide="ignore", invalid="ignore"):
+        psia = np.where(alpha > 0.0, -np.expm1(-alpha * dp) / np.where(alpha > 0.0, alpha, 1.0),
+                        dp)
+    return _panel_hertz_k(tables, theory, E, pH, a, pa, pb, psia, al=alpha * E)
+
+
 def _roelands_hertz_k(tables, theory, E, pH, a, pa, pb, A, Z, pr):
-    """(k = 12 η0 q/h³ [Pa/m], converged) of Roelands O-rings (p_a <= p_H, Δp > 0) by the same
-    panel collocation as the Barus ones (:func:`_barus_hertz_k`), in the reduced pressure
-    ψ = ∫η0/η dp tabulated per row (:mod:`._roelands_psi`): k = ψ_a/(a W)."""
-    o = solver_options({"tol": BARUS_PANEL_TOL, "max_panels": 256})
+    """:func:`_panel_hertz_k` of Roelands O-rings, ψ = ∫η0/η dp tabulated per row
+    (:mod:`._roelands_psi`; ψ_a from the same table the solver builds)."""
     prn = np.ascontiguousarray(pr / E, dtype=np.float64)
-    vis = np.ascontiguousarray(np.column_stack((A, Z, prn)))
-    out = solve_profile_rows(seal_context(tables, theory), o, 0, np.zeros(2), np.zeros(2),
-                             pH / E, pa / E, pb / E, np.arange(E.size),
-                             pa >= (1.0 - NEAR_LIFT_OFF) * pH, None, vis, chain=True)
     psia = np.empty(E.size)
     psi_drops(np.ascontiguousarray(A), np.ascontiguousarray(Z), prn,
               np.ascontiguousarray((pa - pb) / E), psia)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = E * psia / (a * out.W)
-    ok = (out.status != _panels.ST_NEWTON_FAILED) & (out.status != _panels.ST_NO_ZONE) \
-        & np.isfinite(k) & (k > 0.0)
-    return np.where(ok, k, np.nan), ok
+    return _panel_hertz_k(tables, theory, E, pH, a, pa, pb, E * psia,
+                          vis=np.column_stack((A, Z, prn)))
 
 
 def _base_columns(v):
