@@ -170,6 +170,22 @@ def test_rows_do_not_depend_on_their_batch(T):
         assert ref["status"].iloc[i] == one["status"].iloc[0]
 
 
+def test_targets_equal_as_doubles_are_computed_once(T):
+    """t_ratio_1.01 is t_star (ū = 1.01 ū∞): the fast kernel copies it; every other target
+    is computed, and the copied column still agrees with the per-case quadrature."""
+    from fastcontact.squeeze._fastpath import same_targets
+    r1s = np.array([0.01, 0.1, 1.01 - 1.0, 0.001])  # t_star, then the default ratios
+    assert same_targets(r1s, np.array([0.5, 0.25, 0.5])).tolist() == [-1, -1, 0, -1, -1, -1, 4]
+    assert same_targets(np.array([0.01, 0.0100001]), np.zeros(0)).tolist() == [-1, -1]
+    rng = np.random.default_rng(7)
+    p0 = np.exp(rng.uniform(math.log(2e3), math.log(3e5), 200))
+    kw = dict(p0=p0, E_star=E, R=R, eta=ETA, theory="emt", u_start=rng.uniform(2e-4, 1e-2, 200))
+    f = squeeze_out(T, **kw)
+    np.testing.assert_array_equal(f["t_ratio_1.01"], f["t_star"])
+    q = squeeze_out(T, **kw, method="quad", quad_order=20, quad_width=0.25)
+    np.testing.assert_allclose(f["t_ratio_1.01"], q["t_ratio_1.01"], rtol=2e-7)
+
+
 # ------------------------------------------------------------------ invariants
 def test_passed_targets_are_exactly_zero_and_times_nonnegative(T):
     p0 = np.geomspace(1e3, 1e6, 50)

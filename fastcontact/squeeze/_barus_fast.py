@@ -17,7 +17,7 @@ from numba import get_thread_id, njit, prange
 from ..kernels.borrow import borrowed
 
 from ._barus_primitive import BarusTable, s_value, series_order, shift, u_at_time
-from ._fastpath import ZTargets, _target_time, row_targets
+from ._fastpath import ZTargets, _target_time, row_targets, same_targets
 from ._kernels import Cases, Quad
 from ._primitive_eval import (Primitive, inverse_constants, one_plus_exp, row_value, stencil,
                               t_of_z)
@@ -83,6 +83,9 @@ def _target_times(bt, pr, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt
     both ends near it); the Barus part A [S(target) - S(start)] from the correction table."""
     nr = zt.r1s.size
     for k in range(T.shape[0]):
+        if zt.src[k] >= 0:  # the same target as an earlier one
+            T[k, i] = T[zt.src[k], i]
+            continue
         vt = vinf * (1.0 + (zt.r1s[k] if k < nr else zt.dvs[k - nr] / vinf))
         if vt >= vs:
             T[k, i] = 0.0
@@ -221,4 +224,4 @@ def ratio_rows(pr, tg):
         raise ValueError("the Barus targets must start with t_star's ratio 1.01")
     rt = row_targets(pr, tg.ratios[1:], tg.dvs)
     r1s = np.ascontiguousarray(np.concatenate(([0.01], tg.ratios[1:] - 1.0)))
-    return ZTargets(r1s, np.log(r1s), tg.dvs, rt.lnT), rt.lnTs
+    return ZTargets(r1s, np.log(r1s), tg.dvs, rt.lnT, same_targets(r1s, tg.dvs)), rt.lnTs

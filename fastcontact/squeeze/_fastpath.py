@@ -29,8 +29,9 @@ __all__ = ["fast_kernel", "history_kernel", "one_case_primitive", "RowTargets", 
 RowTargets = namedtuple("RowTargets", "lnT lnTs lnTv vsh")
 #: the per-call target tables of :func:`fast_kernel` (built in the kernel, before its loop):
 #: r1s = ū/ū∞ - 1 of t_star and the ratios [-], zr = ln r1s, dvs = Δu/h_rms of the Δu
-#: targets [-], lnT the :data:`RowTargets` table of all the targets
-ZTargets = namedtuple("ZTargets", "r1s zr dvs lnT")
+#: targets [-], lnT the :data:`RowTargets` table of all the targets, src (1 + nr + nd) the
+#: earlier target each one equals (-1: none; :func:`same_targets`)
+ZTargets = namedtuple("ZTargets", "r1s zr dvs lnT src")
 #: a per-case start within GUARD_Z (in z = ln(ū/ū∞ - 1)) above a target takes the target
 #: from the same interpolant as the start (t_of_z), so that the difference stays >= 0; a
 #: target farther below takes its T from the row table
@@ -210,6 +211,26 @@ def _u_at(pr, st, vinf, vs, zs, Ts, Ts_row, tt, h, ic):
     return min(vinf * one_plus_exp(z), vs) * h, Ts
 
 
+@njit(cache=True)
+def same_targets(r1s, dvs):
+    """src (1 + nr + nd): for each time target of :data:`ZTargets` (t_star and the ratios by
+    r1 = ū/ū∞ - 1, then the Δu targets dv), the earlier target it equals (-1: none), so that
+    the kernels compute it once. Ratio targets are equal when their ratios 1 + r1 are the same
+    double: ``t_ratio_1.01`` is t_star (ū = 1.01 ū∞; 1.01 - 1 and 0.01 differ by 9e-16
+    relative, below the resolution of the ratio 1.01 itself, 1e-14 in r1)."""
+    nr = r1s.size - 1
+    src = np.full(r1s.size + dvs.size, -1, dtype=np.int64)
+    for k in range(1, r1s.size):
+        for j in range(k):
+            if src[k] < 0 and 1.0 + r1s[k] == 1.0 + r1s[j]:
+                src[k] = j
+    for k in range(dvs.size):
+        for j in range(k):
+            if src[1 + nr + k] < 0 and dvs[k] == dvs[j]:
+                src[1 + nr + k] = 1 + nr + j
+    return src
+
+
 #: cases per block of :func:`fast_kernel`: each stage of the per-case work runs over a block
 #: before the next, so that the CPU overlaps independent cases (one case alone is a chain of
 #: dependent exp/log and interpolations: latency-bound)
@@ -271,7 +292,8 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
     r1s[0] = 0.01
     r1s[1:] = tg.ratios - 1.0
     zr = np.log(r1s)
-    zt = ZTargets(r1s, zr, dvs, lnT)
+    src = same_targets(r1s, dvs)
+    zt = ZTargets(r1s, zr, dvs, lnT, src)
     n = p0.size
     T_ext = tail_top(pr)
     for blk in prange((n + BLOCK - 1) // BLOCK):
@@ -321,9 +343,13 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
             t_trap[i] = math.inf
             flf[i] = 0.0
         for k in range(nT):  # stage 3: the time targets
+            ks = src[k]
             for i in range(b0, b1):
                 c = i - b0
                 if scr[c, _LIVE] == 0.0:
+                    continue
+                if ks >= 0:  # the same target as an earlier one
+                    T_out[k, i] = T_out[ks, i]
                     continue
                 tk, Ts = _target_time(pr, _st_of(scr, c), scr[c, _VINF], scr[c, _VS],
                                       scr[c, _ZS], scr[c, _TS], scr[c, _TSR], scr[c, _TAU], k,
