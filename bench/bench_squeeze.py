@@ -55,6 +55,9 @@ REF_P0 = {"average": [2e3, 0.2e6], "critical_junction": [0.2e6], "emt": [0.2e6]}
 
 
 def timed(fn, repeats):
+    """Median wall time [s] of ``repeats`` calls after one untimed call (the first call of a
+    path in a process pays its output arrays' fresh pages; bench/alloc_results.md)."""
+    fn()
     ts = []
     for _ in range(repeats):
         t = time.perf_counter()
@@ -191,7 +194,7 @@ def first_call(th, repeats):
 
 def main(quick=False):
     T = Tables.from_parquet(default_table_path(SURFACE))
-    n_fast, n_quad, rep = (100_000, 500, 2) if quick else (1_000_000, 2_000, 3)
+    n_fast, n_quad, rep = (100_000, 500, 2) if quick else (1_000_000, 2_000, 5)
     for th in REF_P0:  # compile and build (not timed)
         squeeze_out(T, p0=1e5, E_star=E, R=R, eta=ETA, theory=th, times=(1.0,), du=(1e-6,))
         tire_footprint(T, p0=2e5, E_star=E, R=R, eta=ETA, theory=th, footprint_length=0.1,
