@@ -385,7 +385,7 @@ def solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, near, al=None, 
     viscosity), ``vis`` (rows, 3) their Roelands law (A, Z, π_r = p_r/E*) (None: none).
     ``chain`` (Hertz rows, kind 0): rows sharing π_H, π_b and the fluid are solved in chains of
     rising π_a, each row started on the previous one's solution
-    (:func:`._panels.solve_rows_chained`, :func:`_chains`; W within ~1e-10 of a cold solve).
+    (:func:`._panels.solve_rows_chained`, :func:`_chains`; W within ~1e-8 of a cold solve).
     Not the rows next to lift-off: Q has a square-root limit there and converges slowly in
     the tolerance, and a warm start left one 3e-8 from its cold solve."""
     out = RowsOut.empty(amp.size)
