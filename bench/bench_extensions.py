@@ -58,6 +58,7 @@ from fastcontact.squeeze import squeeze_out  # noqa: E402
 from fastcontact.figures.asperity_figures import plot_asperity_tstar  # noqa: E402
 from fastcontact.squeeze.asperity import TIRE_CASE, asperity_levels  # noqa: E402
 from fastcontact.squeeze.viscosity import squeeze_out_piezo  # noqa: E402
+from results_notes import write_keeping_notes  # noqa: E402
 from fastcontact.tables.defaults import default_surface  # noqa: E402
 from machine_info import cpu_model  # noqa: E402
 from reference.ext_reynolds import hertz_shoot, squeeze_time  # noqa: E402
@@ -670,7 +671,7 @@ def main():
     lines += body
     out = HERE / ("extensions_results.md" if args.only == ap.get_default("only")
                   else f"extensions_results_{args.only.replace(',', '_')}.md")
-    out.write_text("\n".join(lines) + "\n")
+    write_keeping_notes(out, "\n".join(lines) + "\n")
     print("\n".join(lines))
 
 
