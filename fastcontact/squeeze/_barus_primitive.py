@@ -118,24 +118,43 @@ def series_order(c, A):
     if not (A <= API_FAST):
         return -1
     pw = A * A  # A^(K+1) · A at K = 0
+    thr = SERIES_TOL * (1.0 - A)  # the bound times (1 - A): no division per order
     for k in range(K_MAX + 1):
-        if c[k + 1] * pw / (1.0 - A) <= SERIES_TOL:
+        if c[k + 1] * pw <= thr:
             return k
         pw *= A
     return -1
 
 
+def _binomials(n):
+    """(n + 1, n + 1): C(k, j) for j <= k <= n, 0 above the diagonal (exact in float64 for
+    n <= 56)."""
+    B = np.zeros((n + 1, n + 1))
+    for k in range(n + 1):
+        for j in range(k + 1):
+            B[k, j] = float(math.comb(k, j))
+    return B
+
+
+#: C(k, j), k, j <= K_MAX (the largest, C(48, 24) ≈ 3.2e13, is exact)
+BINOMIALS = _binomials(K_MAX)
+
+
 @njit(cache=True)
 def shift(c, A, K, E):
     """E_j = Σ_{k=j}^K C(k, j) c_k A^k, j = 0..K, into E (Taylor shift by one of the
-    coefficients c_k A^k; positive terms only)."""
+    coefficients c_k A^k; positive terms only). Each order k adds C(k, j) c_k A^k to every
+    E_j, j <= k: the K + 1 sums are independent, so the inner loop has no chain of dependent
+    additions (the Pascal-triangle recurrence had one of K²/2 adds, ~75 ns/case at K ≈ 10)."""
+    B = BINOMIALS
+    for j in range(K + 1):
+        E[j] = 0.0
     p = 1.0
     for k in range(K + 1):
-        E[k] = c[k] * p
+        ak = c[k] * p
         p *= A
-    for i in range(K):
-        for k in range(K - 1, i - 1, -1):
-            E[k] += E[k + 1]
+        for j in range(k + 1):
+            E[j] += B[k, j] * ak
 
 
 @njit(cache=True, inline="always")
