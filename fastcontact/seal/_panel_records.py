@@ -32,13 +32,15 @@ class Zone(NamedTuple):
 
 class State(NamedTuple):
     """One Newton state at the nodes: contact pressure c, resistance density r = dξ/dt / σ̄(c),
-    D = dr/dc, tail integrals R̃ and residuals F."""
+    D = dr/dc, tail integrals R̃, residuals F and (Roelands fluids only) η/η0 at the nodes'
+    fluid pressure, kept from the residual for the Newton matrix."""
 
     c: np.ndarray
     r: np.ndarray
     D: np.ndarray
     Rt: np.ndarray
     F: np.ndarray
+    er: np.ndarray
 
 
 class Work(NamedTuple):
@@ -77,7 +79,7 @@ class Mesh(NamedTuple):
 
 @njit(cache=True)
 def _state(N):
-    return State(np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N))
+    return State(np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N))
 
 
 @njit(cache=True)

@@ -43,7 +43,7 @@ from numba import njit, prange
 from ._mesh import (array_zone, geometry, interp_series, panel_series, remaining_fraction,
                     solve_small, zone_params)
 from ._panel_records import Mesh, State, Work, Zone, _work
-from ._roelands_psi import eta_ratio, fluid_of, no_psi_table, psi_eta, psi_of, psi_table
+from ._roelands_psi import fluid_of, no_psi_table, psi_eta, psi_of, psi_table
 from ._sigma import sig_d
 
 __all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "solve_rows_chained", "ST_OK",
@@ -138,7 +138,7 @@ def _resid(tab, sc, rule, st, dxi, eb, dpi, al, rt, pan, P):
 
     ok is False if σ̄ = 0 somewhere (c at/after percolation: infinite resistance)."""
     n, wl, At = rule.n, rule.wl, rule.At
-    c, r, D, Rt, F = st
+    c, r, D, Rt, F, er_ = st
     N = P * n
     for i in range(N):
         ci = c[i]
@@ -172,6 +172,7 @@ def _resid(tab, sc, rule, st, dxi, eb, dpi, al, rt, pan, P):
         if roel:
             ps, er = psi_eta(rt, eb[i] - c[i])
             F[i] = (ps - dpi * Rt[i] / W) * er
+            er_[i] = er
         elif al == 0.0:
             F[i] = eb[i] - c[i] - dpi * Rt[i] / W
         else:
@@ -202,7 +203,7 @@ def _newton(tab, sc, rule, wk, dpi, al, rt, P, maxit, ftol):
             break
         its += 1
         now, trial = (wk.s0, wk.s1) if cur == 0 else (wk.s1, wk.s0)
-        cc, DD, RR, FF = now.c, now.D, now.Rt, now.F
+        cc, DD, RR, FF, EE = now.c, now.D, now.Rt, now.F, now.er
         ct = trial.c
         # B̃ y = b for b1 = -F and b2 = u = dπ R̃/W²: block back-substitution from the outlet
         g = dpi / W
@@ -213,8 +214,8 @@ def _newton(tab, sc, rule, wk, dpi, al, rt, P, maxit, ftol):
             for i in range(n):
                 # Barus: row i's coupling times P'(ψ_i) = 1/(1 − α̃ ψ_i) (1 for α̃ = 0);
                 # Roelands: times η/η0 at the node's fluid pressure (F scaled by it)
-                if roel:
-                    gi = g * eta_ratio(rt, eb[p * n + i] - cc[p * n + i])
+                if roel:  # η/η0 of the residual that gave this state (the same value)
+                    gi = g * EE[p * n + i]
                 else:
                     gi = g if al == 0.0 else g / (1.0 - al * g * RR[p * n + i])
                 for k in range(n):
