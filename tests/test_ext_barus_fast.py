@@ -257,3 +257,33 @@ def test_u_at_times(tables, theory):
     t_ref = squeeze_time(tables, theory, p0[i], E_STAR, R, ETA, alpha[i], r.u_start,
                          r[names[k]], r.u_inf, rtol=1e-10)
     assert abs(t_ref / times[k] - 1) < 1e-6
+
+
+def test_thick_films_above_the_flat_film_tail(tables):
+    """A start and ū(t) far above v_ext (where π_c/π0 < e^-40 and the correction table gives
+    way to the flat-film tail): the fast path's ū(t) and tire exit against the per-case
+    quadrature, and the rate factor at the start. (ln π_c read NaN above v_ext: ū(t) came
+    back as ū(0) and the start's rate factor as NaN on an "ok" row, before 2026-11-27.)"""
+    model = squeeze_model(tables, "emt")
+    bt, _ = model.barus_table()
+    h = tables.h_rms
+    us = 50.0 * bt.v_ext * h
+    times = np.array([1e-16, 1e-13, 1e-10, 1e-6])
+    kw = dict(p0=2e5, E_star=E_STAR, R=R, eta=ETA, alpha_pv=1e-6, theory="emt", u_start=us,
+              times=times)
+    fast = squeeze_out_piezo(tables, method="fast", **kw)
+    quad = squeeze_out_piezo(tables, method="quad", **kw)
+    names = [c for c in fast.columns if c.startswith("u_at_")]
+    U, Uq = fast[names].to_numpy()[0], quad[names].to_numpy()[0]
+    assert U[0] > bt.v_ext * h and U[-1] < bt.v_ext * h   # above and below the tail's start
+    assert np.all(np.diff(U) < 0) and U[0] < us
+    np.testing.assert_allclose(U - fast.u_inf[0], Uq - quad.u_inf[0], rtol=2e-7)
+    g, gq = fast.filter(like="rate").to_numpy(), quad.filter(like="rate").to_numpy()
+    assert g.size == 1 and np.isfinite(g).all()          # was NaN on an "ok" row
+    np.testing.assert_allclose(g, gq, rtol=1e-12)
+    tf = dict(p0=2e5, E_star=E_STAR, R=R, eta=ETA, alpha_pv=1e-6, theory="emt", u_start=us,
+              footprint_length=times[:3], speed=1.0)
+    ef = tire_footprint(tables, method="fast", **tf)
+    eq = tire_footprint(tables, method="quad", **tf)
+    np.testing.assert_allclose(ef.u_exit, eq.u_exit, rtol=2e-7)
+    assert np.all(ef.u_exit < us)

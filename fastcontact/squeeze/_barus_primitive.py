@@ -159,9 +159,11 @@ def shift(c, A, K, E):
 
 @njit(cache=True, inline="always")
 def s_value(bt, E, K, x0, v):
-    """(S(v), ln π_c(v)): S = Σ_{j<=K} E_j (-y)^j R_j(v), y = π_c(v)/π0, π0 = e^x0."""
+    """(S(v), ln π_c(v)): S = Σ_{j<=K} E_j (-y)^j R_j(v), y = π_c(v)/π0, π0 = e^x0. Above
+    v_ext π_c/π0 < e^-40 is neglected, as in the flat-film tail: ln π_c = -inf there (so that
+    d = 1 - π_c/π0 is 1, not NaN)."""
     if v >= bt.v_ext:
-        return E[0] * qk._tail_int(bt.c, v + bt.d, math.inf), math.nan
+        return E[0] * qk._tail_int(bt.c, v + bt.d, math.inf), -math.inf
     s = math.log(v)
     sn = bt.xn
     i = _locate(bt, s)
