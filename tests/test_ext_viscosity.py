@@ -455,7 +455,7 @@ def test_seal_hertz_sweep_chains_match_single_rows(tables, law, monkeypatch):
     """A batch of O-rings is solved in chains (rows sharing p_H, p_b and the fluid, rising in
     p_a; each row's Newton started on the previous row's solution). A shuffled batch of two
     O-rings' Δp sweeps (up to 0.98 p_H, and next to lift-off) equals each row solved on its
-    own (a batch of one: a cold solve) within 2e-8 (at the panel tolerance 1e-6 a warm start
+    own (a batch of one: a cold solve) within 5e-9 (at the panel tolerance 1e-6 a warm start
     keeps a mesh refined for the previous row: measured <= 1.3e-9 here; 60-row sweeps of 64
     O-rings on the embedded surfaces were <= 1e-8 from the DOP853 reference, their cold
     solves <= 1.1e-9), and chains of more than one row did run; three rows also against the
@@ -487,7 +487,7 @@ def test_seal_hertz_sweep_chains_match_single_rows(tables, law, monkeypatch):
     assert (batch.status == "ok").all() and max(spied) > 1
     for k in range(dp.size):
         one = seal_leak_piezo(tables, R=R[k], f_N=f_N[k], dp=dp[k], **kw)
-        assert abs(batch.Q[k] / one.Q[0] - 1) < 2e-8, (k, batch.Q[k] / one.Q[0] - 1)
+        assert abs(batch.Q[k] / one.Q[0] - 1) < 5e-9, (k, batch.Q[k] / one.Q[0] - 1)
     for k in np.flatnonzero(dp <= 0.98 * pH)[:3]:
         if law == "barus":
             ref = hertz_shoot(_sigma(tables, "emt"), pH[k], a[k], dp[k], 0.0, 1e-5)

@@ -28,12 +28,11 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from ..flow.piezoviscosity import ln_roelands
 from ..kernels.hermite import quintic_unit
 from ..kernels.quadrature import gauss_legendre
 
-__all__ = ["PsiTable", "psi_table", "no_psi_table", "psi_of", "psi_eta", "fluid_of", "eta_ratio",
-           "psi_drops", "PSI_CELL", "PSI_STEEP", "PSI_REACH"]
+__all__ = ["PsiTable", "psi_table", "no_psi_table", "psi_of", "psi_eta", "fluid_of", "psi_drops",
+           "PSI_CELL", "PSI_STEEP", "PSI_REACH"]
 
 #: a table of ψ(π): the law (A, Z, π_r), the node width h in u = ln(1 + π/π_r), the values
 #: y = ψ, g = dψ/du and s = d²ψ/du² at the nodes u_k = k h (size 0: no Roelands fluid)
@@ -89,14 +88,6 @@ def no_psi_table():
 
 
 @njit(cache=True, inline="always")
-def eta_ratio(rt, pi):
-    """η/η0 at the fluid pressure π above the outlet (1 at or below it)."""
-    if pi <= 0.0:
-        return 1.0
-    return math.exp(ln_roelands(pi, rt.A, rt.Z, rt.pr))
-
-
-@njit(cache=True, inline="always")
 def _psi_at(rt, pi, u):
     """ψ at π > 0 with u = ln(1 + π/π_r) given."""
     n = rt.y.size - 1
@@ -120,7 +111,8 @@ def psi_of(rt, pi):
 
 @njit(cache=True)
 def psi_eta(rt, pi):
-    """(ψ(π), η/η0 at π): :func:`psi_of` and :func:`eta_ratio` sharing u = ln(1 + π/π_r)."""
+    """(ψ(π), η/η0 at π): :func:`psi_of` and the law's η/η0 (ln η/η0 = A[(1 + π/π_r)^Z - 1],
+    as :func:`fastcontact.flow.piezoviscosity.ln_roelands`) sharing u = ln(1 + π/π_r)."""
     if pi <= 0.0:
         return pi, 1.0
     u = math.log1p(pi / rt.pr)

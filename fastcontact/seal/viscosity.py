@@ -21,7 +21,7 @@ conductivity σ0 at the outlet viscosity η0 and the reduced pressure
   p_cont(x) = p0(x) - p_b - P(ψ_a R(x)/W), P(ψ) = -ln(1 - αψ)/α, R(x) = ∫_x^{x_e} dx'/σ0: the
   base engine's integral equation (eq. 33) with Δp ψ-weighted. It is solved by the base
   engine's adaptive Gauss–Legendre panel collocation and Newton
-  (:mod:`fastcontact.seal._panels`, panel tolerance BARUS_PANEL_TOL). With ``steps`` given,
+  (:mod:`fastcontact.seal._panels`, panel tolerance PIEZO_PANEL_TOL). With ``steps`` given,
   by shooting on q instead (RK4 in θ, x = a(1 - cos θ), on steps graded towards both zone
   ends; bracketed secant iteration on q, started from the root of a 25-step shooting).
 
@@ -67,8 +67,8 @@ __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
 #: DOP853 shooting reference, bench/bench_extensions.py): the O-ring shooting (given
 #: ``steps``, and the fallback of rows whose panel Newton fails)
 HERTZ_STEPS = 200
-#: panel tolerance of the Barus O-ring's collocation solve (the base seal engine's solver in
-#: ψ; relative Legendre tail of the resistance density per panel); at or within
+#: panel tolerance of the O-rings' collocation solve, Barus and Roelands (the base seal
+#: engine's solver in ψ; relative Legendre tail of the resistance density per panel); at or within
 #: NEAR_LIFT_OFF below the lift-off equality p_a = p_H, where Q has a square-root limit and
 #: converges slowly in the tolerance, the base engine's EQUALITY_TOL
 #: (bench/extensions_results.md). Against the DOP853 shooting (rtol 1e-13) on the four
@@ -76,7 +76,7 @@ HERTZ_STEPS = 200
 #: (oil-like and steep), p_a/p_H = 0.02–0.99, 448 O-rings solved cold: worst 1.07e-9 at 1e-6,
 #: the same as at 1e-7, 1.5e-8 at 1e-5, 2.1e-6 at 1e-4; the same O-rings inside 67-row Δp
 #: sweeps (solved in chains): 9.95e-9 at 1e-6, 1.07e-9 at 1e-7. 1e-6 is ×1.3–1.4 faster
-BARUS_PANEL_TOL = 1e-6
+PIEZO_PANEL_TOL = 1e-6
 #: the default shooting of O-rings (rows whose panel Newton fails: Barus at α p_H >~ 5 next
 #: to lift-off, steep Roelands laws) is checked (:func:`_checked_shooting`): (HERTZ_STEPS/2, HERTZ_STEPS) steps,
 #: then rows whose two results differ by more than FALLBACK_RTOL (relative) with
@@ -582,7 +582,7 @@ def _panel_hertz_k(tables, theory, E, pH, a, pa, pb, psia, al=None, vis=None):
     engine's panel collocation in ψ (:mod:`._panels`, chained along Δp sweeps): k = ψ_a/(a W),
     ψ_a [Pa] the fluid's reduced pressure drop, W the reduced resistance of the sealing zone;
     ``al`` the Barus α̃ = α E* per row, ``vis`` (rows, 3) the Roelands law (A, Z, p_r/E*)."""
-    o = solver_options({"tol": BARUS_PANEL_TOL, "max_panels": 256})
+    o = solver_options({"tol": PIEZO_PANEL_TOL, "max_panels": 256})
     out = solve_profile_rows(seal_context(tables, theory), o, 0, np.zeros(2), np.zeros(2),
                              pH / E, pa / E, pb / E, np.arange(E.size),
                              pa >= (1.0 - NEAR_LIFT_OFF) * pH, al, vis, chain=True)
