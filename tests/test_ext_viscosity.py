@@ -43,6 +43,15 @@ def tables():
     return fc.precompute(psd, theories=("average", "critical_junction", "emt"))
 
 
+@pytest.fixture(autouse=True)
+def _no_kept_beta_tables():
+    """Every test starts without the β tables earlier calls kept (which path a batch takes
+    must not depend on the order the tests run in)."""
+    import fastcontact.seal.viscosity as sv
+
+    sv._BETA_TABLES.clear()
+
+
 def _sigma(tables, theory):
     plo = tables.p_range[0] * E_STAR
     return lambda pc: tables.conductivity(np.maximum(pc, plo * (1 + 1e-7)), E_STAR, ETA, theory)
@@ -354,6 +363,78 @@ def test_seal_barus_cells_match_per_row(tables, theory):
     # weights beyond e^200 over the table: the per-row path, same numbers
     got_big, calls = _table_calls(tables, dict(kw, alpha_pv=np.full(n, 1e-4)))
     assert not calls and (got_big.status == "ok").all() and np.all(got_big.Q > 0)
+
+
+def test_seal_barus_tables_kept_across_calls(tables, monkeypatch):
+    """A β table built by one call serves later calls sharing α E* (same theory and rule) with
+    any number of rows: a short call (no table of its own) reads it, its rings equal to the
+    per-row reference (10x narrower panels, 16 Gauss points) to 5e-11 and to the separate BVP
+    to 1e-8; another theory or rule builds its own; at most BETA_MEMO are kept (the oldest
+    dropped); they go with their Tables object."""
+    import gc
+
+    from fastcontact.kernels.quadrature import gauss_legendre
+    from fastcontact.seal._piezo_kernels import Quad, _uniform_kernel
+    import fastcontact.seal.viscosity as sv
+
+    builds = []
+    real = sv._ring_cells
+
+    def counted(*args, **kwargs):
+        builds.append(args[4:])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(sv, "_ring_cells", counted)
+    rng = np.random.default_rng(11)
+    n = sv.BARUS_TABLE_ROWS + 10
+    p0 = rng.uniform(2e4, 6e4, n)
+    kw = dict(p0=p0, dp=0.5 * p0, L=5e-3, L_y=L_Y, E_star=E_STAR, eta=ETA, alpha_pv=3e-5,
+              theory="emt")
+    seal_leak_piezo(tables, **kw)
+    assert len(builds) == 1
+    # a short Δp sweep of one ring: alone it would take the sweep kernel, now the kept table
+    dps = np.linspace(1e3, 4.5e4, 40)
+    short = dict(kw, p0=5e4, dp=dps)
+    got, calls = _table_calls(tables, short)
+    assert len(builds) == 1 and len(calls) == 1 and calls[0]["rows"].p0.size == dps.size
+    x, w = gauss_legendre(16)
+    ref = np.empty(dps.size)
+    c = calls[0]
+    _uniform_kernel(c["tab"], c["sc"], c["rows"], 0.0, Quad(x, w, 0.05), ref)
+    err = np.max(np.abs(c["out"] / ref - 1))
+    assert err < 5e-11, err
+    for i in (5, 30):
+        q, _ = seal_bvp(_sigma(tables, "emt"), lambda xx: 5e4 + 0 * xx, 0.0, 5e-3, dps[i], 0.0,
+                        3e-5)
+        assert abs(got.Q[i] / (q * L_Y) - 1) < 1e-8
+    # the same short sweep with no table kept: the sweep kernel, the same Q to 5e-11
+    sv._BETA_TABLES.clear()
+    fresh, calls = _table_calls(tables, short)
+    assert not calls and len(builds) == 1
+    np.testing.assert_allclose(got.Q.to_numpy(), fresh.Q.to_numpy(), rtol=5e-11, atol=0)
+    # another theory or another rule: tables of their own
+    seal_leak_piezo(tables, **kw)
+    seal_leak_piezo(tables, **dict(kw, theory="critical_junction"))
+    seal_leak_piezo(tables, **dict(kw, quad_order=12))
+    assert len(builds) == 4
+    _, calls = _table_calls(tables, dict(short, theory="critical_junction"))
+    assert len(calls) == 1 and len(builds) == 4
+    # at most BETA_MEMO kept, the oldest dropped (the first emt table: a short call no longer
+    # finds it)
+    for k in range(sv.BETA_MEMO):
+        seal_leak_piezo(tables, **dict(kw, alpha_pv=1e-5 * (1 + k / 64)))
+    memo = sv._beta_memo(tables)
+    assert len(memo) == sv.BETA_MEMO
+    _, calls = _table_calls(tables, short)
+    assert not calls
+    # kept per Tables object, dropped with it
+    psd = fc.SelfAffinePSD(h_rms=5e-6, hurst=0.8, q0=1e4, q1=1e8)
+    other = fc.precompute(psd, theories=("emt",))
+    seal_leak_piezo(other, **kw)
+    assert len(sv._BETA_TABLES) == 2
+    del other
+    gc.collect()
+    assert len(sv._BETA_TABLES) == 1
 
 
 @pytest.mark.parametrize("theory", ["emt", "critical_junction"])

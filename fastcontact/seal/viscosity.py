@@ -11,9 +11,11 @@ conductivity σ0 at the outlet viscosity η0 and the reduced pressure
   ``q = (1/L)∫σ_eff dp``). Evaluated by Gauss–Legendre in ln p_cont on the tables. In
   x = ln(p_cont/E*) it is q L = E* e^{-α(p0 - p_b)} ∫_{x_a}^{x_b} σ̄ e^x e^{αE* e^x} dx: the
   weight does not depend on p0, so rings sharing α E* (but not p0) read one cumulative table
-  of that integral per call (cells of 0.02 in x, prefix and suffix sums, the integrand's
-  Legendre series on each cell) and evaluate only the two partial cells at their ends
-  (:func:`_ring_cells`); a long Δp sweep of any law shares one such table of its run, and a
+  of that integral (cells of 0.02 in x, prefix and suffix sums, the integrand's Legendre
+  series on each cell) and evaluate only the two partial cells at their ends
+  (:func:`_ring_cells`). The table is built by a call with enough such rings (~1 ms) and
+  kept with the Tables object (the newest ``BETA_MEMO``), so later calls sharing α E*, short
+  ones too, read it; a long Δp sweep of any law shares one such table of its run, and a
   short one adds each row's piece to the previous row's integral.
 * **Hertz O-ring** (p0(x) = p_H √(1 - ((x-a)/a)²)): dψ/dx = -q/σ0(p0(x) - p_f(ψ)) has no
   closed form. Integrated from the outlet, ψ(x) = q ∫_x^{x_e} dx'/σ0, so with
@@ -46,6 +48,8 @@ B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019.
 from __future__ import annotations
 
 import math
+import weakref
+from collections import OrderedDict
 
 import numpy as np
 import pandas as pd
@@ -178,7 +182,8 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
     sc = _scalars(tables, theory)
     tab = tables.kernel_data(theory)
     if profile == "uniform":
-        cols, rows = _uniform_rows(tab, sc, v, law, quad_order, quad_width)
+        cols, rows = _uniform_rows(tab, sc, v, law, quad_order, quad_width, _beta_memo(tables),
+                                   theory)
     else:
         cols, rows = _hertz_rows(tables, theory, tab, sc, v, law, steps)
     kq, conv, lift, perc, out_t, pmax = rows
@@ -268,8 +273,8 @@ SHORT_ORDER = 4
 #: percolation; CELL_SHORT_ORDER of them for a ring inside one smooth cell). Barus
 #: rings separate exactly, q L η0 = E* e^{-α(p0 - p_b)} ∫ σ̄ e^x e^{β e^x} dx with
 #: β = α E*, so rings sharing β (BARUS_TABLE_ROWS of them or more; distinct p0 too)
-#: share one table (β·e^{x_top} above BARUS_BETA_TOP_MAX, weights below e^-200 at the
-#: table's bottom, keeps the per-row integral); rings of any law sharing p0 - p_b, E* and the
+#: share one table, kept for later calls (β·e^{x_top} above BARUS_BETA_TOP_MAX, weights below
+#: e^-200 at the table's bottom, keeps the per-row integral); rings of any law sharing p0 - p_b, E* and the
 #: law (a Δp sweep of SWEEP_TABLE_ROWS rings or more) share one table of their run. Shorter
 #: sweeps add each ring's piece to the previous one's integral (:func:`_sweep_order`)
 CELL_WIDTH = 0.02
@@ -278,6 +283,10 @@ CELL_SHORT_ORDER = 4
 BARUS_TABLE_ROWS = 2048
 SWEEP_TABLE_ROWS = 8192
 BARUS_BETA_TOP_MAX = 200.0
+#: β tables kept per Tables object (the newest): a loop of calls sharing α E* (one call per
+#: seal geometry, each a Δp or p0 sweep) builds each once (~1 ms, ~0.1 MB each)
+BETA_MEMO = 16
+_BETA_TABLES = weakref.WeakKeyDictionary()
 
 
 def _ring_cells(tab, sc, quad, x1, run=0, beta=0.0, E=0.0, P=0.0, A=0.0, Z=0.0, pr=0.0):
@@ -348,33 +357,58 @@ def _table_rows(tab, sc, sub, idx, bc, quad, out, done):
     done[idx] = True
 
 
-def _barus_groups(beta, top):
-    """[(β, rows)] of the Barus flat rings that take a cumulative table: groups of at least
-    BARUS_TABLE_ROWS rows sharing β = α E* with β·top <= BARUS_BETA_TOP_MAX (rows None: all
-    of them)."""
+def _barus_groups(beta, top, kept, build):
+    """[(β, rows)] of the Barus flat rings that take a cumulative table (rows None: all of
+    them): β = α E* with β·top <= BARUS_BETA_TOP_MAX, and either a table kept from an earlier
+    call (β in ``kept``: any number of rows) or, where ``build``, a group of at least
+    BARUS_TABLE_ROWS rows sharing β."""
     n = beta.size
-    if n < BARUS_TABLE_ROWS:
-        return []
     if beta.min() == beta.max():
-        return [(float(beta[0]), None)] if beta[0] * top <= BARUS_BETA_TOP_MAX else []
-    if not _shares([beta], n):
+        b = float(beta[0])
+        if b * top <= BARUS_BETA_TOP_MAX and (b in kept or (build and n >= BARUS_TABLE_ROWS)):
+            return [(b, None)]
+        return []
+    if not kept and not (build and n >= BARUS_TABLE_ROWS):
+        return []
+    if n > BARUS_TABLE_ROWS and not _shares([beta], n):
         return []
     u, inv, cnt = np.unique(beta, return_inverse=True, return_counts=True)
-    return [(float(u[g]), np.flatnonzero(inv == g)) for g in np.flatnonzero(
-        (cnt >= BARUS_TABLE_ROWS) & (u * top <= BARUS_BETA_TOP_MAX))]
+    use = (u * top <= BARUS_BETA_TOP_MAX) & (np.isin(u, list(kept)) |
+                                             (build & (cnt >= BARUS_TABLE_ROWS)))
+    return [(float(u[g]), np.flatnonzero(inv == g)) for g in np.flatnonzero(use)]
 
 
-def _barus_tabled(tab, sc, sub, quad, out, done):
+def _barus_tabled(tab, sc, sub, quad, out, done, memo, theory):
     """Fill ``out`` for the Barus flat rings (columns ``sub`` as in :func:`_uniform_rows`) that
-    share a β table (:func:`_barus_groups`), marking them in ``done``. A short Δp sweep (fewer
-    than SWEEP_TABLE_ROWS rings) keeps the sweep kernel: building a table costs more there."""
+    share a β table (:func:`_barus_groups`), marking them in ``done``. The tables are kept in
+    ``memo`` (:func:`_beta_memo`) and serve later calls with any number of rows; a new one is
+    not built for a short Δp sweep (fewer than SWEEP_TABLE_ROWS rings), which keeps the sweep
+    kernel: building a table costs more there."""
     p0, _L, _pa, pb, E, A, _Z = sub
     keys = [k for k in (E, p0, pb, A) if k.min() != k.max()]
-    if (not keys or _shares(keys, out.size)) and out.size < SWEEP_TABLE_ROWS:
-        return
+    build = not ((not keys or _shares(keys, out.size)) and out.size < SWEEP_TABLE_ROWS)
     x1 = min(float(sc[0]["x_hi"]), float(sc[0]["x_perc"]))
-    for beta, idx in _barus_groups(A * E, math.exp(x1)):
-        _table_rows(tab, sc, sub, idx, _ring_cells(tab, sc, quad, x1, 0, beta), quad, out, done)
+    rule = (theory, quad.x.size, quad.width)
+    kept = {k[3] for k in memo if k[:3] == rule}
+    for beta, idx in _barus_groups(A * E, math.exp(x1), kept, build):
+        key = rule + (beta,)
+        bc = memo.get(key)
+        if bc is None:
+            bc = memo[key] = _ring_cells(tab, sc, quad, x1, 0, beta)
+            while len(memo) > BETA_MEMO:
+                memo.popitem(last=False)
+        else:
+            memo.move_to_end(key)
+        _table_rows(tab, sc, sub, idx, bc, quad, out, done)
+
+
+def _beta_memo(tables):
+    """The β tables kept for ``tables``: an OrderedDict by (theory, rule order, rule width, β),
+    newest last, dropped with the Tables object."""
+    memo = _BETA_TABLES.get(tables)
+    if memo is None:
+        memo = _BETA_TABLES[tables] = OrderedDict()
+    return memo
 
 
 def _run_tabled(tab, sc, sub, pr, quad, out, done):
@@ -443,7 +477,7 @@ def _sweep_order(sub):
     return order, np.append(starts, n).astype(np.int64)
 
 
-def _uniform_rows(tab, sc, v, law, quad_order, quad_width):
+def _uniform_rows(tab, sc, v, law, quad_order, quad_width, memo, theory):
     """(columns, (k, converged, lift, percolated, out_of_table, p_max)) of flat rings; k =
     12 η0 q / h³ [Pa/m] by the uniform-ring integral of every running row."""
     E, pa, pb, p0v, Lv = v["E"], v["pa"], v["p_b"], v["g1"], v["g2"]
@@ -462,7 +496,7 @@ def _uniform_rows(tab, sc, v, law, quad_order, quad_width):
         quad = Quad(x, w, float(quad_width))
         done = np.zeros(out.size, dtype=bool)
         if law is None:
-            _barus_tabled(tab, sc, sub, quad, out, done)
+            _barus_tabled(tab, sc, sub, quad, out, done, memo, theory)
         _run_tabled(tab, sc, sub, float(pr), quad, out, done)
         rest = np.flatnonzero(~done)
         if rest.size:
