@@ -16,11 +16,11 @@ from numba import get_thread_id, njit, prange
 
 from ..kernels.borrow import borrowed
 
-from ._barus_primitive import BarusTable, s_value, series_order, shift, u_at_time
+from ._barus_primitive import BarusTable, s_at, s_value, series_order, shift, u_at_time
 from ._fastpath import ZTargets, _target_time, row_targets, same_targets
 from ._kernels import Cases, Quad
-from ._primitive_eval import (Primitive, inverse_constants, one_plus_exp, row_value, stencil,
-                              t_of_z)
+from ._primitive_eval import (Primitive, inverse_constants_ext, one_plus_exp, row_value,
+                              stencil, t_of_z, tail_top)
 from .tire_piezo import _BELOW as TIRE_BELOW
 from .tire_piezo import _OK as TIRE_OK
 from .tire_piezo import TireOut, _tire_case
@@ -68,20 +68,22 @@ def _start(pr, bt, st, E, K, x0, vs_in, lnTs):
         zs = math.log(vs / vinf - 1.0)
         Ts = t_of_z(pr, st, vinf, zs)
         Ts_row = Ts
-    Ss, lnps = s_value(bt, E, K, x0, vs)
-    return vinf, vs, zs, Ts, Ts_row, Ss, -math.expm1(lnps - x0)
+    Ss, ys = s_value(bt, E, K, x0, vs)
+    return vinf, vs, zs, Ts, Ts_row, Ss, 1.0 - ys
 
 
 @njit(cache=True, inline="always")
-def _target_times(bt, pr, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt, T, i):
+def _target_times(bt, pr, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt, l1r, T, i):
     """Times [s] from the start to each target (t_star and the ratios × v∞, then v∞ + dv;
     ``zt`` the :data:`~._fastpath.ZTargets` of :func:`ratio_rows`) into column i; returns
     T(start) (computed here if a target needed it, else as given).
 
     The base part T(target) - T(start) is the base fast path's
     (:func:`~._fastpath._target_time`: row tables far below the start, the interpolant at
-    both ends near it); the Barus part A [S(target) - S(start)] from the correction table."""
+    both ends near it); the Barus part A [S(target) - S(start)] from the correction table,
+    at ln v = ln v∞ + ``l1r`` (ln(1 + r) of each ratio target, computed once per call)."""
     nr = zt.r1s.size
+    lnvinf = row_value(pr.lnv, st)  # ln v∞ (v∞ is its exp)
     for k in range(T.shape[0]):
         if zt.src[k] >= 0:  # the same target as an earlier one
             T[k, i] = T[zt.src[k], i]
@@ -90,7 +92,7 @@ def _target_times(bt, pr, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt
         if vt >= vs:
             T[k, i] = 0.0
             continue
-        S, _ = s_value(bt, E, K, x0, vt)
+        S, _ = s_at(bt, E, K, x0, vt, lnvinf + l1r[k] if k < nr else math.log(vt))
         dt, Ts = _target_time(pr, st, vinf, vs, zs, Ts, Ts_row, tau, k, zt)
         T[k, i] = dt + tau * A * (S - Ss)
     return Ts
@@ -111,6 +113,8 @@ def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, quad, o
     status = out.status
     times = tg.times
     us = cs.us
+    l1r = np.log1p(zt.r1s)
+    T_ext = tail_top(pr)  # T at v_ext, the same for every case
     for i in prange(cs.p0.size):
         x0, tau, A, K, st = _served(pr, sc, c, cs, alpha, h, x_fast, i)
         if K < 0:
@@ -129,11 +133,11 @@ def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, quad, o
         g_start[i] = _rate_factor(A * ds) if A > 0.0 else 1.0
         status[i] = ST_OK
         Ts = _target_times(bt, pr, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt,
-                           T_out, i)
+                           l1r, T_out, i)
         if times.size:
             if Ts < 0.0:
                 Ts = t_of_z(pr, st, vinf, zs)
-            ic = inverse_constants(pr, st)
+            ic = inverse_constants_ext(pr, st, T_ext)
             for k in range(times.size):
                 U_out[k, i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss,
                                         times[k] / tau, ic) * h
@@ -170,6 +174,8 @@ def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, quad
     status = out.status
     us = cs.us
     nT = T_out.shape[0]
+    l1r = np.log1p(zt.r1s)
+    T_ext = tail_top(pr)  # T at v_ext, the same for every case
     for i in prange(cs.p0.size):
         x0, tau, A, K, st = _served(pr, sc, c, cs, alpha, h, x_fast, i)
         if K < 0:
@@ -191,13 +197,13 @@ def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, quad
         flf[i] = 0.0
         status[i] = TIRE_OK
         Ts = _target_times(bt, pr, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt,
-                           T_out, i)
+                           l1r, T_out, i)
         if t_fp.size == 0:  # the exit is not asked for
             u_exit[i] = math.nan
             continue
         if Ts < 0.0:
             Ts = t_of_z(pr, st, vinf, zs)
-        ic = inverse_constants(pr, st)
+        ic = inverse_constants_ext(pr, st, T_ext)
         u_exit[i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, t_fp[i] / tau,
                               ic) * h
 

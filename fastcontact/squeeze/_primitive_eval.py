@@ -197,6 +197,28 @@ def t_of_zv(pr, st, vinf, z, v):
 
 
 @njit(cache=True, inline="always")
+def t_slope_of_zv(pr, st, vinf, z, v):
+    """(T, dT/dz) at z, v = v∞(1 + e^z) given: :func:`t_of_zv` and its slope (the closed-form
+    tail: dT/dv = -1/(y³ - c y), y = v + d, times dv/dz = v - v∞; below the grid the analytic
+    part's; on the grid T times the quintic's d ln T/dz)."""
+    if v >= pr.v_ext:
+        y = v + pr.d
+        return _tail_T(pr, v), -(v - vinf) / (y * (y * y - pr.c))
+    z = z + row_value(pr.lk, st)
+    if z < pr.z0:
+        T0, h0, S = _below(pr, st)
+        e = math.expm1(z - pr.z0)
+        return T0 + S * (pr.z0 - z) - (h0 - S) * e, -S - (h0 - S) * (1.0 + e)
+    k = int((z - pr.z0) / pr.dz)
+    if k > pr.nz - 2:
+        k = pr.nz - 2
+    t = (z - (pr.z0 + k * pr.dz)) / pr.dz
+    q, dq = _quintic(t, pr.dz, _cell(pr, st, k))
+    T = math.exp(q)
+    return T, T * dq
+
+
+@njit(cache=True, inline="always")
 def z_of_t(pr, st, vinf, T):
     """z = ln(v/v∞ - 1) with T(x0, v) = T (inverse of t_of_z; T = inf gives -inf)."""
     return z_of_t_at(pr, st, vinf, T, inverse_constants(pr, st))
@@ -343,11 +365,6 @@ def _halley_cell(cf, h, lt, t):
         if (halley and step <= HALLEY_ACCEPT) or step <= 1e-13 or b - a <= 1e-13:
             break
     return t
-
-
-#: a Newton step of at most this ends an iteration (the Barus primitive's inverse): the step
-#: after it would be ~ |f″/(2f′)| · 1e-16, below the round-off
-NEWTON_ACCEPT = 1e-8
 
 
 @njit(cache=True, inline="always")
