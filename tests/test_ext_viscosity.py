@@ -437,6 +437,30 @@ def test_seal_barus_tables_kept_across_calls(tables, monkeypatch):
     assert len(sv._BETA_TABLES) == 1
 
 
+def test_seal_barus_kept_tables_under_threads(tables, monkeypatch):
+    """Calls from several threads at once, each building and reading β tables while others
+    evict them (a memo of 2): every call returns what it returns alone."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    import fastcontact.seal.viscosity as sv
+
+    monkeypatch.setattr(sv, "BETA_MEMO", 2)
+    n = sv.BARUS_TABLE_ROWS + 10
+    p0 = np.random.default_rng(12).uniform(2e4, 6e4, n)
+    alphas = [1e-5 * (1 + k / 8) for k in range(6)] * 3
+
+    def leak(al):
+        return seal_leak_piezo(tables, p0=p0, dp=0.5 * p0, L=5e-3, L_y=L_Y, E_star=E_STAR,
+                               eta=ETA, alpha_pv=al, theory="emt").Q.to_numpy()
+
+    alone = {al: leak(al) for al in alphas[:6]}
+    with ThreadPoolExecutor(4) as pool:
+        got = list(pool.map(leak, alphas))
+    for al, q in zip(alphas, got):
+        np.testing.assert_array_equal(q, alone[al])
+    assert len(sv._beta_memo(tables)) == 2
+
+
 @pytest.mark.parametrize("theory", ["emt", "critical_junction"])
 def test_seal_run_table_matches_per_row(tables, theory):
     """A long Δp sweep of one Roelands ring next to percolation (SWEEP_TABLE_ROWS rows or more,

@@ -48,6 +48,7 @@ B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019.
 from __future__ import annotations
 
 import math
+import threading
 import weakref
 from collections import OrderedDict
 
@@ -287,6 +288,7 @@ BARUS_BETA_TOP_MAX = 200.0
 #: seal geometry, each a Δp or p0 sweep) builds each once (~1 ms, ~0.1 MB each)
 BETA_MEMO = 16
 _BETA_TABLES = weakref.WeakKeyDictionary()
+_BETA_LOCK = threading.Lock()
 
 
 def _ring_cells(tab, sc, quad, x1, run=0, beta=0.0, E=0.0, P=0.0, A=0.0, Z=0.0, pr=0.0):
@@ -389,26 +391,31 @@ def _barus_tabled(tab, sc, sub, quad, out, done, memo, theory):
     build = not ((not keys or _shares(keys, out.size)) and out.size < SWEEP_TABLE_ROWS)
     x1 = min(float(sc[0]["x_hi"]), float(sc[0]["x_perc"]))
     rule = (theory, quad.x.size, quad.width)
-    kept = {k[3] for k in memo if k[:3] == rule}
+    with _BETA_LOCK:  # calls from several threads share the memo
+        kept = {k[3] for k in memo if k[:3] == rule}
     for beta, idx in _barus_groups(A * E, math.exp(x1), kept, build):
         key = rule + (beta,)
-        bc = memo.get(key)
+        with _BETA_LOCK:
+            bc = memo.get(key)
+            if bc is not None:
+                memo.move_to_end(key)
         if bc is None:
-            bc = memo[key] = _ring_cells(tab, sc, quad, x1, 0, beta)
-            while len(memo) > BETA_MEMO:
-                memo.popitem(last=False)
-        else:
-            memo.move_to_end(key)
+            bc = _ring_cells(tab, sc, quad, x1, 0, beta)
+            with _BETA_LOCK:
+                memo[key] = bc
+                while len(memo) > BETA_MEMO:
+                    memo.popitem(last=False)
         _table_rows(tab, sc, sub, idx, bc, quad, out, done)
 
 
 def _beta_memo(tables):
     """The β tables kept for ``tables``: an OrderedDict by (theory, rule order, rule width, β),
     newest last, dropped with the Tables object."""
-    memo = _BETA_TABLES.get(tables)
-    if memo is None:
-        memo = _BETA_TABLES[tables] = OrderedDict()
-    return memo
+    with _BETA_LOCK:
+        memo = _BETA_TABLES.get(tables)
+        if memo is None:
+            memo = _BETA_TABLES[tables] = OrderedDict()
+        return memo
 
 
 def _run_tabled(tab, sc, sub, pr, quad, out, done):
