@@ -213,7 +213,7 @@ def u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic):
     Newton in z from the base solution z(Ts + tt) (one inverse), G' = T'(z)/g(a): each step
     is a forward evaluation of T and S, no inverse (~35 against ~90 ns). A step of at most
     Z_ACCEPT ends it, its result taken: the error left is of order |G''/G'| · Z_ACCEPT², at the
-    round-off of z (most cases take 3 steps)."""
+    round-off of z."""
     if tt == 0.0:
         return vs
     if tt == math.inf:

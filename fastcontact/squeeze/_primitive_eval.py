@@ -182,23 +182,14 @@ def t_of_z(pr, st, vinf, z):
 
 @njit(cache=True, inline="always")
 def t_of_zv(pr, st, vinf, z, v):
-    """:func:`t_of_z` where the caller has v = v∞(1 + e^z) already (saves an exp)."""
-    if v >= pr.v_ext:
-        return _tail_T(pr, v)
-    z = z + row_value(pr.lk, st)
-    if z < pr.z0:
-        T0, h0, S = _below(pr, st)
-        return T0 + S * (pr.z0 - z) - (h0 - S) * math.expm1(z - pr.z0)
-    k = int((z - pr.z0) / pr.dz)
-    if k > pr.nz - 2:
-        k = pr.nz - 2
-    t = (z - (pr.z0 + k * pr.dz)) / pr.dz
-    return math.exp(_quintic(t, pr.dz, _cell(pr, st, k))[0])
+    """:func:`t_of_z` where the caller has v = v∞(1 + e^z) already (saves an exp); the value
+    of :func:`t_slope_of_zv` (inlined: the slope's extra arithmetic is dropped)."""
+    return t_slope_of_zv(pr, st, vinf, z, v)[0]
 
 
 @njit(cache=True, inline="always")
 def t_slope_of_zv(pr, st, vinf, z, v):
-    """(T, dT/dz) at z, v = v∞(1 + e^z) given: :func:`t_of_zv` and its slope (the closed-form
+    """(T(x0, v), dT/dz) at z, v = v∞(1 + e^z) given for the stencil st (the closed-form
     tail: dT/dv = -1/(y³ - c y), y = v + d, times dv/dz = v - v∞; below the grid the analytic
     part's; on the grid T times the quintic's d ln T/dz)."""
     if v >= pr.v_ext:
