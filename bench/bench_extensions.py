@@ -77,6 +77,10 @@ def _unchained(solve_profile_rows):
 
 
 def timed(fn, repeats=5):
+    """Median wall time [s] of ``repeats`` calls after one untimed call (a path's first call
+    in a process pays its result arrays' fresh pages; bench/alloc_results.md). Calls that
+    measure a cold state reset it themselves (``cold_sweep``)."""
+    fn()
     ts = []
     for _ in range(repeats):
         t0 = time.perf_counter()
