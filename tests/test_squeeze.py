@@ -90,6 +90,37 @@ def test_du_and_user_start_vs_reference(T):
         assert _rel(df["t_star"].iloc[0] / tau, ref.t_ratio(1.01, v_start=vs)) < 1e-6
 
 
+def test_u_deep_in_the_exponential_approach_vs_reference(T):
+    """ū − ū∞ at 10 and 14 relaxation times past t* (ū − ū∞ ~ 1e-7…1e-9 ū∞, below the
+    primitive's z grid) within 1e-6 relative of the reference's, at a pressure between two
+    of the primitive's rows. Checked as time: there d ln(ū − ū∞)/dt = −1/t_relax, so the
+    reference time from the start to the engine's ū − ū∞ (each from its own ū∞) must be t
+    within 1e-6 t_relax. (The slope below the grid was interpolated across the rows in S
+    instead of ln S before 2026-11-27: 1.4e-6 to 5.4e-6 off at 10 t_relax.)"""
+    from fastcontact.squeeze.primitive import fast_limit
+
+    m = squeeze_model(T, "average")
+    xn = m.primitive().xn
+    j = int(np.searchsorted(xn, fast_limit(m) - 0.3))
+    p0 = math.exp(0.5 * (xn[j] + xn[j + 1])) * E
+    ref = SqueezeReference(T.surface, E, "average", p0)
+    v_start = ref.default_start()
+    tau = tau0(ETA, R, T.h_rms, p0)
+    base = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, theory="average", ratios=())
+    t_rel = base["t_relax"].iloc[0]
+    times = base["t_star"].iloc[0] + np.array([10.0, 14.0]) * t_rel
+    for method in ("fast", "quad"):
+        df = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, theory="average", ratios=(),
+                         times=times, method=method)
+        names = [c for c in df.columns if c.startswith("u_at_")]
+        assert len(names) == 2
+        for t, c in zip(times, names):
+            dv = (df[c].iloc[0] - df["u_inf"].iloc[0]) / T.h_rms
+            assert 1e-10 < dv / ref.v_inf < 1e-6, (method, dv / ref.v_inf)
+            t_ref = tau * ref.time(ref.v_inf + dv, v_start)
+            assert abs(t_ref - t) < 1e-6 * t_rel, (method, c, (t_ref - t) / t_rel)
+
+
 @pytest.mark.parametrize("theory", ["critical_junction", "emt"])
 def test_start_far_beyond_table(T, theory):
     pi0 = 1e-6

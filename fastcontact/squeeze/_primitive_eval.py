@@ -23,8 +23,10 @@ __all__ = ["Primitive", "first_row", "stencil", "row_value", "row_value_2", "t_o
 
 #: the tabulated primitive (reduced units). xn (nx) x0 nodes and their locator (blo, bdz,
 #: bidx: fractional row index at uniform x0 samples from blo, step bdz); z0, dz, nz: the z grid; C (nx, nz, 3): ln T, d ln T/dz,
-#: d² ln T/dz²; lnv (nx): ln v∞; lnS (nx): ln of the relaxation time in τ0; zs (nx): z of the
-#: default start; sx (nx): slope dT/d(-z) below the grid; lk (nx): ln κ, the shift of the grid
+#: d² ln T/dz²; lnv (nx): ln v∞; lnS (nx): ln of the relaxation time in τ0 (the slope
+#: dT/d(-z) below the grid); zs (nx): z of the default start; sx (nx): that slope fitted to the
+#: two lowest nodes (a build check, = e^lnS within ~2e-8; not read by the evaluation, which
+#: interpolates ln S); lk (nx): ln κ, the shift of the grid
 #: variable ζ = z + ln κ (κ = (1 + (d ln σ̄/d ln v)² + (d ln π_c/d ln v)²)^½ at v∞, so that
 #: the grid resolves rows where σ̄ collapses); v_ext, c, d: closed-form tail; lag (nx - 3, 4):
 #: :func:`lagrange_denominators`
@@ -155,12 +157,17 @@ def _tail_v(pr, T):
 
 @njit(cache=True, inline="always")
 def _below(pr, st):
-    """(T0, h0, S) at the bottom of the z grid for the combined rows."""
+    """(T0, h0, S) at the bottom of the z grid for the combined rows: T and dT/d(-z) at node 0
+    (the cell's quintic at its left end) and the slope S = dT/d(-z) at equilibrium, the
+    relaxation time t_relax/τ0, from the rows' ln S (interpolating ln S across the rows is
+    exact to ~5e-9 at their midpoints, S itself only to ~1e-6 — where S grows by orders of
+    magnitude over the x0 range — and S D sets ū - ū∞ = ū∞ e^z deep in the exponential
+    approach, D = z0 - z relaxation times below the grid)."""
     j0, w0, w1, w2, w3 = st
-    C = pr.C  # ln T and d ln T/dz at node 0 (the cell's quintic at its left end)
+    C = pr.C
     T0 = math.exp(row_value_2(C, st, 0))
     dl0 = w0 * C[j0, 0, 1] + w1 * C[j0 + 1, 0, 1] + w2 * C[j0 + 2, 0, 1] + w3 * C[j0 + 3, 0, 1]
-    return T0, -T0 * dl0, row_value(pr.sx, st)
+    return T0, -T0 * dl0, math.exp(row_value(pr.lnS, st))
 
 
 #: below this z = ln(v/v∞ - 1), e^z < 2^-54: 1 + e^z rounds to 1 exactly
