@@ -22,7 +22,8 @@ __all__ = ["load_or_build", "write", "read", "set_primitive_cache", "primitive_p
 
 #: format and model version of the stored primitives (files of another version are rebuilt);
 #: 3: the tail's decay length u0 from the table's exact slope at its top (2026-11-26)
-PRIMITIVE_VERSION = 3
+#: 4: z grid spacing 0.2 instead of 0.25 (2026-11-27)
+PRIMITIVE_VERSION = 4
 _CACHE_ATTR = "_squeeze_primitive_dir"
 
 
