@@ -4,7 +4,7 @@ Every case is a few interpolations: the base primitive T at the start and at eac
 and the Barus correction S of :mod:`._barus_primitive` at the same separations,
 t = τ0 {T(ū) - T(ū_start) + α p0 [S(ū) - S(ū_start)]}; ū at the footprint exit by Newton on
 the same two (:func:`~._barus_primitive.u_at_time`). Rows the tables do not serve this way
-(outside the tables, p0 within 4.6 % of the trap pressure or beyond, α p0 > API_FAST) run the
+(outside the tables, p0 within 4.4 % of the trap pressure or beyond, α p0 > API_FAST) run the
 per-case quadrature of :mod:`.viscosity` / :mod:`.tire_piezo` in the same pass.
 """
 from __future__ import annotations

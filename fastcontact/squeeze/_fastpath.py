@@ -2,7 +2,7 @@
 
 Every output is a few interpolations of the primitive T(x0, ū) per case
 (:mod:`fastcontact.squeeze.primitive`): t(a → b) = τ0 [T(b) - T(a)], ū(t) from
-T(ū) = T(ū_start) + t/τ0. Rows the primitive does not serve (trapped fluid, p0 within 4.6 % of
+T(ū) = T(ū_start) + t/τ0. Rows the primitive does not serve (trapped fluid, p0 within 4.4 % of
 the trap pressure) fall back to the per-case quadrature in the same pass.
 """
 from __future__ import annotations

@@ -270,13 +270,14 @@ def profile(model, v_lo):
 
 
 #: rows end X_END below the trap pressure (or the tables' kink, :func:`_kink`); cases within
-#: X_FALLBACK of it use the per-case quadrature (4.6 % in p0; σ̄ collapses there faster than
-#: any fixed grid resolves). The last rows resolve T at the grid's bottom less well, and deep
-#: in the exponential approach (ū − ū∞ ∝ e^(-t/t_relax), where an error δT of T moves
-#: ln(ū − ū∞) by δT/S) that shows: ū − ū∞ at 0.5–15 t_relax past t* was off the per-case
-#: quadrature by more than 1e-6 (up to 2.4e-6, as against the independent reference, where the
-#: quadrature is within 2e-8) up to 0.028 below the rows' end (critical junction and EMT on the four embedded tables; t* within
-#: 2e-7). The margin was 0.01 (trap) and 0.02 (kink) before 2026-11-27.
+#: X_FALLBACK of it use the per-case quadrature (p0 above 0.956 of it; σ̄ collapses there
+#: faster than any fixed grid resolves). The last rows resolve T at the grid's bottom less
+#: well, and deep in the exponential approach (ū − ū∞ ∝ e^(-t/t_relax), where an error δT of
+#: T moves ln(ū − ū∞) by δT/S) that shows: with margins of 0.01 (trap) and 0.02 (kink), as
+#: before 2026-11-27, ū − ū∞ at 0.5–15 t_relax past t* was off the per-case quadrature by more
+#: than 1e-6 (up to 2.4e-6; the quadrature within 2e-8 of the independent reference there) up
+#: to 0.028 below the rows' end (critical junction and EMT, three of the four embedded tables;
+#: t* within 2e-7); with 0.045, by at most 3.6e-7 in the top 0.05 of the served range
 X_END = 0.005
 X_FALLBACK = 0.045
 

@@ -419,7 +419,7 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     method : {"fast", "quad"}, default "fast"
         "fast": every time is two interpolations of the constant-viscosity time primitive
         plus the tabulated Barus correction (:mod:`._barus_primitive`, built once per
-        tables and theory in ~5-20 ms); rows it does not serve (α p0 > 0.6, p0 within 4.6 % of
+        tables and theory in ~5-20 ms); rows it does not serve (α p0 > 0.6, p0 within 4.4 % of
         the trap pressure or beyond, outside the tables) take the per-case quadrature in the
         same pass. "quad": the per-case quadrature for every row.
     quad_order, quad_width :
