@@ -419,7 +419,7 @@ def one_case_primitive(pr, x0):
     pr1 = Primitive(xn, float(xn[0]), 1.0, np.arange(4.0), lagrange_denominators(xn), pr.z0,
                     pr.dz, pr.nz,
                     np.ascontiguousarray(_one_row(pr.C, st)), _one_row(pr.lnv, st),
-                    _one_row(pr.lnS, st), _one_row(pr.zs, st), _one_row(pr.sx, st),
+                    _one_row(pr.lnS, st), _one_row(pr.zs, st),
                     _one_row(pr.lk, st), pr.v_ext, pr.c, pr.d)
     return pr1, one
 

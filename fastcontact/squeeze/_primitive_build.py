@@ -163,8 +163,7 @@ def _panel(pf, mp, x0, vinf, za, zb, glx, glw):
 
 @njit(cache=True)
 def _build_row(pf, mp, x0, vinf, lk, z0, dz, glx, glw, C, j):
-    """ln T and its z-derivatives at the ζ nodes (z = ζ - lk) of row j; returns the slope
-    S below the grid."""
+    """ln T and its z-derivatives at the ζ nodes (z = ζ - lk) of row j."""
     nz = C.shape[1]
     z_ext = math.log(mp.v_ext / vinf - 1.0) if mp.v_ext > vinf else -math.inf
     z_prev = z_ext
@@ -181,11 +180,6 @@ def _build_row(pf, mp, x0, vinf, lk, z0, dz, glx, glw, C, j):
         C[j, k, 0] = math.log(T)
         C[j, k, 1] = -h / T
         C[j, k, 2] = -h * dlnh / T - (h / T) ** 2
-    # slope below the grid: h(z) = S + a e^z fitted to the two lowest nodes
-    h0 = -C[j, 0, 1] * math.exp(C[j, 0, 0])
-    h1 = -C[j, 1, 1] * math.exp(C[j, 1, 0])
-    a = (h1 - h0) / (math.exp(z0 + dz) - math.exp(z0))
-    return h0 - a * math.exp(z0)
 
 
 @njit(cache=True)
@@ -198,7 +192,7 @@ def _lnkappa(pf, mp, vinf):
 @njit(parallel=True, cache=True)
 def _build_kernel(pf, mp, pr, glx, glw):
     """Fill the rows of ``pr`` (a :data:`Primitive` with its arrays allocated): per x0 node
-    ln v∞, ln κ, ln T and its z-derivatives at the ζ nodes (C), the slope below the grid and
+    ln v∞, ln κ, ln T and its z-derivatives at the ζ nodes (C), ln S (the slope below the grid) and
     the default start's z; ``glx``, ``glw`` the Gauss–Legendre rule of each panel."""
     # the output arrays as locals, one per statement, outside the loop: a store inside a prange
     # body into an array taken from a record argument is lost (numba 0.6x parfor lowering)
@@ -207,7 +201,6 @@ def _build_kernel(pf, mp, pr, glx, glw):
     lnv = pr.lnv
     lnS = pr.lnS
     zs = pr.zs
-    sx = pr.sx
     lk = pr.lk
     z0 = pr.z0
     dz = pr.dz
@@ -217,9 +210,9 @@ def _build_kernel(pf, mp, pr, glx, glw):
         vinf = math.exp(lv)
         lnv[j] = lv
         lk[j] = _lnkappa(pf, mp, vinf)
-        sx[j] = _build_row(pf, mp, x0, vinf, lk[j], z0, dz, glx, glw, C, j)
+        _build_row(pf, mp, x0, vinf, lk[j], z0, dz, glx, glw, C, j)
         e, lm, de, dl = _pstate(pf, mp, vinf)
-        lnS[j] = lv - math.log(-de) - lm  # S = v∞ |d ln v/d ln π| / σ̄(π0)
+        lnS[j] = lv - math.log(-de) - lm  # S = v∞ |d ln v/d ln π| / σ̄(π0): dT/d(-z) at ū∞
         vs = math.exp(_plnv(pf, mp, x0 + mp.lnp_start))
         zs[j] = math.log(vs / vinf - 1.0)
 
@@ -324,7 +317,7 @@ def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, order=NODE_ORDER, check=True):
     z_hi = math.log(mp.v_ext / math.exp(lnv_lo[0]) - 1.0) + lk_max
     nz = int(math.ceil((z_hi - z_lo) / dz)) + 2
     nx = xn.size
-    rows = (np.empty(nx) for _ in range(5))  # lnv, lnS, zs, sx, lk
+    rows = (np.empty(nx) for _ in range(4))  # lnv, lnS, zs, lk
     pr = Primitive(xn, *_index_map(xn), lagrange_denominators(xn), float(z_lo), float(dz), nz,
                    np.empty((nx, nz, 3)), *rows, float(mp.v_ext), float(mp.c), float(mp.d))
     glx, glw = gauss_legendre(order)

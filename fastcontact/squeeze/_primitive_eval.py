@@ -24,13 +24,11 @@ __all__ = ["Primitive", "first_row", "stencil", "row_value", "row_value_2", "t_o
 #: the tabulated primitive (reduced units). xn (nx) x0 nodes and their locator (blo, bdz,
 #: bidx: fractional row index at uniform x0 samples from blo, step bdz); z0, dz, nz: the z grid; C (nx, nz, 3): ln T, d ln T/dz,
 #: d² ln T/dz²; lnv (nx): ln v∞; lnS (nx): ln of the relaxation time in τ0 (the slope
-#: dT/d(-z) below the grid); zs (nx): z of the default start; sx (nx): that slope fitted to the
-#: two lowest nodes (a build check, = e^lnS within ~2e-8; not read by the evaluation, which
-#: interpolates ln S); lk (nx): ln κ, the shift of the grid
+#: dT/d(-z) below the grid); zs (nx): z of the default start; lk (nx): ln κ, the shift of the grid
 #: variable ζ = z + ln κ (κ = (1 + (d ln σ̄/d ln v)² + (d ln π_c/d ln v)²)^½ at v∞, so that
 #: the grid resolves rows where σ̄ collapses); v_ext, c, d: closed-form tail; lag (nx - 3, 4):
 #: :func:`lagrange_denominators`
-Primitive = namedtuple("Primitive", "xn blo bdz bidx lag z0 dz nz C lnv lnS zs sx lk v_ext c d")
+Primitive = namedtuple("Primitive", "xn blo bdz bidx lag z0 dz nz C lnv lnS zs lk v_ext c d")
 
 
 def _index_map(xn, per_node=8):

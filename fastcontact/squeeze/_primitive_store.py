@@ -22,7 +22,8 @@ __all__ = ["load_or_build", "write", "read", "set_primitive_cache", "primitive_p
 
 #: format and model version of the stored primitives (files of another version are rebuilt);
 #: 3: the tail's decay length u0 from the table's exact slope at its top (2026-11-26)
-#: 4: z grid spacing 0.2 instead of 0.25 (2026-11-27)
+#: 4: z grid spacing 0.2 instead of 0.25; no slope_below column (the slope below the grid
+#: is e^ln_S) (2026-11-27)
 PRIMITIVE_VERSION = 4
 _CACHE_ATTR = "_squeeze_primitive_dir"
 
@@ -65,7 +66,7 @@ def write(path, pr, info, model):
     import pyarrow.parquet as pq
 
     nz = pr.nz
-    cols = {"x0": pr.xn, "ln_v_inf": pr.lnv, "ln_S": pr.lnS, "z_start": pr.zs, "slope_below": pr.sx,
+    cols = {"x0": pr.xn, "ln_v_inf": pr.lnv, "ln_S": pr.lnS, "z_start": pr.zs,
             "ln_kappa": pr.lk}
     arrays = {k: pa.array(v) for k, v in cols.items()}
     for q, k in enumerate(("L", "D1", "D2")):
@@ -96,13 +97,12 @@ def read(path, expect_key=None):
         raise ValueError(f"primitive file {str(path)!r} does not belong to these tables")
     nz = int(meta["nz"])
     col = {k: np.ascontiguousarray(table.column(k).to_numpy(), dtype=np.float64)
-           for k in ("x0", "ln_v_inf", "ln_S", "z_start", "slope_below", "ln_kappa")}
+           for k in ("x0", "ln_v_inf", "ln_S", "z_start", "ln_kappa")}
     mats = {k: np.ascontiguousarray(table.column(k).combine_chunks().flatten().to_numpy()
                                     .reshape(-1, nz), dtype=np.float64) for k in ("L", "D1", "D2")}
     xn = col["x0"]
     C = np.ascontiguousarray(np.stack([mats["L"], mats["D1"], mats["D2"]], axis=2))
     pr = Primitive(xn, *_index_map(xn), lagrange_denominators(xn), float(meta["z0"]),
                    float(meta["dz"]), nz, C,
-                   col["ln_v_inf"], col["ln_S"], col["z_start"], col["slope_below"],
-                   col["ln_kappa"], float(meta["v_ext"]), float(meta["c"]), float(meta["d"]))
+                   col["ln_v_inf"], col["ln_S"], col["z_start"], col["ln_kappa"], float(meta["v_ext"]), float(meta["c"]), float(meta["d"]))
     return pr, meta["info"]
