@@ -35,7 +35,7 @@ def cubic_uniform(t, t0, dt, val, der):
             + (-2 * u3 + 3 * u2) * val[i + 1] + (u3 - u2) * dt * der[i + 1])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _quintic_value(t, h, y0, d0, s0, y1, d1, s1):
     """The quintic Hermite polynomial at t = (x - x0)/h in [0, 1] (one copy for both kernels).
 
@@ -74,7 +74,7 @@ def quintic_interval(x, x0, x1, y0, y1, d0, d1, s0, s1):
     return _quintic_value((x - x0) / h, h, y0, d0, s0, y1, d1, s1)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def quintic_unit(t, h, y0, d0, s0, y1, d1, s1):
     """(value, d/dx) of the quintic Hermite at t = (x - x0)/h in [0, 1], interval width h.
 
