@@ -8,6 +8,8 @@ Paths (embedded road tables ``asphalt_024mm``, three theories):
 * ``default start``: ratio targets from the default start (p_cont = 1e-3 p0);
 * ``given start``: per-case ``u_start`` and a Δu target;
 * ``times``: ū at three times from per-case starts;
+* ``given start, Δu, one time``: per-case starts, a Δu target and ū at one time (the issue's
+  "per-case u_start, du and times" with a single time: one inversion per case);
 * ``tire``: ``tire_footprint`` with every column, distinct pressures, speeds and footprint
   lengths (ū at each case's own exit time); its error also covers a reference case inside a
   batch that shares its start (the start's T from the per-call row table);
@@ -113,7 +115,8 @@ def references(T):
 def path_errors(T, th, refs, method):
     """Max relative errors (default start, given start, times, tire exit) vs the reference."""
     h = T.h_rms
-    e = {"default": 0.0, "given": 0.0, "times": 0.0, "tire": 0.0, "tire_exit": 0.0}
+    e = {"default": 0.0, "given": 0.0, "times": 0.0, "tire": 0.0, "tire_exit": 0.0,
+         "given_du_time": 0.0}
     for r in refs:
         tau = tau0(ETA, R, h, r["p0"])
         d = squeeze_out(T, p0=r["p0"], E_star=E, R=R, eta=ETA, theory=th, method=method)
@@ -124,6 +127,13 @@ def path_errors(T, th, refs, method):
         e["given"] = max(e["given"], abs(g["t_star"].iloc[0] / tau / r["t_giv"] - 1))
         dv = (g[column_name("u_at", t_at)].iloc[0] - g["u_inf"].iloc[0]) / h
         e["times"] = max(e["times"], abs(dv / r["dv_at"] - 1))
+        # Δu target and one time in one call: t to ū∞ + 0.01 ū∞ (= t_star) and ū at t_at
+        dv_t = 0.01 * r["v_inf"] * h
+        g = squeeze_out(T, p0=r["p0"], E_star=E, R=R, eta=ETA, theory=th, u_start=r["vs"],
+                        ratios=(), du=(dv_t,), times=(t_at,), method=method)
+        dv = (g[column_name("u_at", t_at)].iloc[0] - g["u_inf"].iloc[0]) / h
+        e["given_du_time"] = max(e["given_du_time"], abs(dv / r["dv_at"] - 1),
+                                 abs(g[column_name("t_du", dv_t)].iloc[0] / tau / r["t_giv"] - 1))
         for key, cols in (("tire", None), ("tire_exit", list(EXIT_COLUMNS) + ["u_inf"])):
             f = tire_footprint(T, p0=r["p0"], E_star=E, R=R, eta=ETA, theory=th,
                                footprint_length=t_at, speed=1.0, u_start=r["vs"],
@@ -161,6 +171,9 @@ def speeds(T, th, n_fast, n_quad, repeats):
             "times": lambda: squeeze_out(T, p0=p0, E_star=E, R=Rr, eta=ETA, theory=th,
                                          u_start=us, ratios=(), times=(1e-5, 1e-3, 1e-1),
                                          method=method),
+            "given start, Δu, one time": lambda: squeeze_out(
+                T, p0=p0, E_star=E, R=Rr, eta=ETA, theory=th, u_start=us, ratios=(),
+                du=(1e-6,), times=(1e-3,), method=method),
             "tire": lambda: tire_footprint(T, p0=p0, E_star=E, R=Rr, eta=ETA, theory=th,
                                            footprint_length=fl, speed=sp, method=method),
             "tire, exit columns": lambda: tire_footprint(
@@ -230,10 +243,11 @@ def write(rows, t_ref, load0, load1, n_fast, n_quad):
          "| theory | path | fast: cases/s | fast: max rel. err | quad: cases/s | quad: max rel. err | fast / quad speed |",
          "|---|---|---|---|---|---|---|"]
     emap = {"default start": "default", "given start": "given", "times": "times", "tire": "tire",
-            "tire, exit columns": "tire_exit", "history": "times"}
+            "tire, exit columns": "tire_exit", "history": "times",
+            "given start, Δu, one time": "given_du_time"}
     for th, r in rows.items():
-        for path in ("default start", "given start", "times", "tire", "tire, exit columns",
-                     "history"):
+        for path in ("default start", "given start", "times", "given start, Δu, one time",
+                     "tire", "tire, exit columns", "history"):
             f, q = r["speed"][(path, "fast")], r["speed"][(path, "quad")]
             L.append(f"| {th} | {path} | {f:.3g} | {r['err_fast'][emap[path]]:.1e} | {q:.3g} | "
                      f"{r['err_quad'][emap[path]]:.1e} | {f / q:.3g} |")
@@ -241,7 +255,9 @@ def write(rows, t_ref, load0, load1, n_fast, n_quad):
                  f"{r['ivp_rate']:.3g} | {r['ivp_err']:.1e} | "
                  f"{r['speed'][('default start', 'fast')] / r['ivp_rate']:.3g} |")
     L += ["", "Errors: t* (default and given start), ū - ū∞ at a time (times, history) and at "
-          "the footprint exit (tire) against the reference. \"tire, exit columns\": "
+          "the footprint exit (tire) against the reference; \"given start, Δu, one time\": "
+          "the worse of t to ū∞ + 0.01 ū∞ (a Δu target) and ū - ū∞ at a time, in one call "
+          "(its speed: a Δu target of 1 µm and ū at 1 ms per case). \"tire, exit columns\": "
           f"`tire_footprint(columns={list(EXIT_COLUMNS)})`, which computes only ū at the exit "
           "(no ratio or Δu targets), its error measured on that call. History cases/s are "
           "(case × time) "

@@ -102,3 +102,60 @@ def test_columns_select_what_the_kernel_computes(T, method, monkeypatch):
         assert list(df.columns) == list(cols)
         assert calls == ([] if targets is None else [targets]), cols
         assert_columns_match(df, full, cols)
+
+
+@pytest.mark.parametrize("method", ["fast", "quad"])
+@pytest.mark.parametrize("u_start", [None, 1e-2, np.nan])
+def test_shared_inputs_are_one_value_not_a_million_copies(T, method, u_start):
+    """E*, R, η and ū(0) given as one number reach the kernels as one value (size-1 case
+    arrays, no array of n copies): every column equals the call with the same values spelled
+    out per case — with rows out of the tables (per-case quadrature rows) in the batch."""
+    import fastcontact.squeeze.tire as tire_mod
+
+    rng = np.random.default_rng(17)
+    n = 400
+    lo, hi = T.p_range
+    p0 = np.exp(rng.uniform(np.log(0.5 * lo * E), np.log(2.0 * hi * E), n))
+    kw = dict(p0=p0, footprint_length=rng.uniform(0.05, 0.2, n), speed=rng.uniform(5, 40, n),
+              theory="emt", method=method)
+    us = {} if u_start is None else {"u_start": u_start}
+    seen = []
+    real = tire_mod.run_cases
+
+    def spy(model, cs, *a, **k):
+        seen.append((cs.E.size, cs.R.size, cs.eta.size, cs.us.size))
+        return real(model, cs, *a, **k)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(tire_mod, "run_cases", spy)
+        if u_start is not None and np.isnan(u_start):
+            with pytest.raises(ValueError, match="u_start"):
+                tire_footprint(T, **kw, E_star=E, R=0.01, eta=1e-3, **us)
+            return
+        one = tire_footprint(T, **kw, E_star=E, R=0.01, eta=1e-3, **us)
+    assert seen == [(1, 1, 1, 1)]
+    per_case = {k: np.full(n, v) for k, v in us.items()}
+    full = tire_footprint(T, **kw, E_star=np.full(n, E), R=np.full(n, 0.01),
+                          eta=np.full(n, 1e-3), **per_case)
+    assert set(one["status"]) >= {"ok", "out_of_table"}
+    for c in full.columns:
+        a, b = one[c].to_numpy(), full[c].to_numpy()
+        if a.dtype.kind in "fb":
+            np.testing.assert_array_equal(a, b, err_msg=c)
+        else:
+            assert (one[c] == full[c]).all(), c
+
+
+def test_case_arrays_of_a_third_size_are_refused(T):
+    """A case array with neither one value per case nor one for all is an error, not an
+    out-of-bounds read in the kernel."""
+    from fastcontact.squeeze import _kernels as qk
+    from fastcontact.squeeze.api import QUAD_ORDER, _check_method, run_cases
+    from fastcontact.squeeze.model import squeeze_model
+
+    model = squeeze_model(T, "average")
+    quad, _ = _check_method("fast", QUAD_ORDER, 1.0, None)
+    cs = qk.Cases(np.full(5, 1e5), np.full(3, E), np.full(1, 0.01), np.full(5, 1e-3),
+                  np.full(1, np.nan))
+    with pytest.raises(ValueError, match="E has 3 values, p0 5"):
+        run_cases(model, cs, np.zeros(0), np.zeros(0), np.zeros((0, 1)), "fast", quad)

@@ -262,8 +262,11 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
     Ratio targets (same z for every case) come from the row tables ``rt`` unless the start
     lies within GUARD_Z above them; there, and for Δu targets, both ends come from t_of_z (one
     interpolant: the difference is accurate and >= 0 however close the target is to the
-    start); ū at times from its inverse z_of_t. ``relax=False`` leaves t_relax NaN on the
-    served rows."""
+    start); ū at times from its inverse z_of_t. ``relax=False`` leaves t_relax, t_trap and
+    tau0 unwritten on the served rows (a caller that reports none of them saves the memory
+    traffic: 24 MB per million rows). The case arrays E, R, eta and us hold one value per case
+    or one value for all (size 1: a study's shared modulus, radius, viscosity or start needs no
+    array of a million copies)."""
     # one field per statement: with tuple unpacking (a, b = rec.a, rec.b) numba 0.6x's parfor
     # lowering keeps only the first array's writes, and a record-field setitem in the loop
     # body (rec.a[i] = x) is lost as well
@@ -282,6 +285,11 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
     R = cs.R
     eta = cs.eta
     us = cs.us
+    # index multipliers: 1 for one value per case, 0 for one value shared by every case
+    sE = 1 if E.size > 1 else 0
+    sR = 1 if R.size > 1 else 0
+    seta = 1 if eta.size > 1 else 0
+    sus = 1 if us.size > 1 else 0
     dvs = tg.dvs
     times = tg.times
     lnT = rt.lnT
@@ -302,10 +310,12 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
         scr = np.empty((b1 - b0, _NSCR))
         for i in range(b0, b1):  # stage 1: τ0, the stencil and v∞; rows not served
             c = i - b0
-            tau = 3.0 * eta[i] * R[i] * R[i] / (2.0 * h * h * p0[i])
-            x0 = math.log(p0[i] / E[i])
-            vs_in = us[i] / h
-            tau0[i] = tau
+            Ri = R[i * sR]
+            tau = 3.0 * eta[i * seta] * Ri * Ri / (2.0 * h * h * p0[i])
+            x0 = math.log(p0[i] / E[i * sE])
+            vs_in = us[i * sus] / h
+            if relax:
+                tau0[i] = tau
             scr[c, _LIVE] = 0.0
             if not (x_lo <= x0 <= x_hi):
                 _slow_row(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
@@ -330,7 +340,7 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
             st = _st_of(scr, c)
             vinf = scr[c, _VINF]
             tau = scr[c, _TAU]
-            zs, vs, Ts, Ts_row = _case_start(pr, st, vinf, us[i] / h, rt)
+            zs, vs, Ts, Ts_row = _case_start(pr, st, vinf, us[i * sus] / h, rt)
             scr[c, _ZS] = zs
             scr[c, _VS] = vs
             scr[c, _TS] = Ts
@@ -338,9 +348,10 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
             scr[c, _BAD] = 0.0 if 0.0 < tau < math.inf else 1.0
             u_inf[i] = vinf * h
             u_start[i] = vs * h
-            t_relax[i] = tau * math.exp(row_value(pr.lnS, st)) if relax else math.nan
+            if relax:
+                t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
+                t_trap[i] = math.inf
             u_trap[i] = math.nan
-            t_trap[i] = math.inf
             flf[i] = 0.0
         for k in range(nT):  # stage 3: the time targets
             ks = src[k]
@@ -392,10 +403,15 @@ def _tau0(tau, i, out):
 @njit(parallel=True, cache=True)
 def quad_kernel(tab, mp, cs, h, tg, quad, out):
     """method="quad": every case by per-case quadrature (one prange pass)."""
+    sE = 1 if cs.E.size > 1 else 0  # size-1 case arrays: shared by every case
+    sR = 1 if cs.R.size > 1 else 0
+    seta = 1 if cs.eta.size > 1 else 0
+    sus = 1 if cs.us.size > 1 else 0
     for i in prange(cs.p0.size):
-        tau = 3.0 * cs.eta[i] * cs.R[i] * cs.R[i] / (2.0 * h * h * cs.p0[i])
-        _slow_row(tab, mp, math.log(cs.p0[i] / cs.E[i]), cs.us[i] / h, tg, tau, h, quad, i,
-                  out)
+        Ri = cs.R[i * sR]
+        tau = 3.0 * cs.eta[i * seta] * Ri * Ri / (2.0 * h * h * cs.p0[i])
+        _slow_row(tab, mp, math.log(cs.p0[i] / cs.E[i * sE]), cs.us[i * sus] / h, tg, tau, h,
+                  quad, i, out)
         _tau0(tau, i, out)
 
 

@@ -122,9 +122,15 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad, relax=True):
     """Evaluate the cases ``cs`` (reduced targets) into a fresh :data:`SqOut` record.
 
     ``times2d`` has shape (n_times, 1) (shared, ascending) or (n_times, n) (per case,
-    ascending along axis 0). ``relax=False``: the fast path leaves t_relax NaN on the rows
-    it serves (a caller that does not report it saves an interpolation per case)."""
+    ascending along axis 0). The case arrays E, R, eta and us of ``cs`` hold n values or one
+    shared by every case. ``relax=False``: a caller that reports none of t_relax, t_trap and
+    tau0 (the fast path then neither computes nor writes them: an interpolation per case and
+    24 MB per million rows); they come back as None."""
     n = cs.p0.size
+    for name in ("E", "R", "eta", "us"):
+        size = getattr(cs, name).size
+        if size not in (1, n):  # the kernels index them by case or read their one value
+            raise ValueError(f"cases: {name} has {size} values, p0 {n} (must be {n} or 1)")
     nt = 1 + ratios.size + dvs.size
     out = qk.SqOut(np.empty((nt, n)), np.empty((times2d.shape[0], n)), *(np.empty(n) for _ in
                    range(7)), np.empty(n, dtype=np.int8))
@@ -136,10 +142,13 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad, relax=True):
     else:
         pr = model.primitive()
         us = cs.us
-        shared = us.size > 1 and us.min() == us.max()  # one start for all (NaN: never equal)
+        # one start for all (NaN: never equal; a size-1 start is shared by every case)
+        shared = n > 1 and (us.size == 1 or us.min() == us.max())
         rt = row_targets(pr, tg.ratios, tg.dvs, us[0] / model.h_rms if shared else math.nan)
         fast_kernel(model.tab, model.mp, pr, rt, fast_limit(model), cs, model.h_rms, tg, quad,
                     out, bool(relax))
+    if not relax:  # not written on the rows the fast path serves: nothing to read
+        out = out._replace(t_relax=None, t_trap=None, tau0=None)
     return out
 
 

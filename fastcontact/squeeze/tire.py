@@ -137,16 +137,17 @@ def _inputs(p0, E_star, R, eta, footprint_length, speed, rho, u_start, alpha_pv=
     except ValueError:
         raise ValueError(f"{', '.join(arrs)} are invalid: shapes "
                          f"{[np.shape(a) for a in arrs.values()]} do not broadcast") from None
-    # one value per case, contiguous (the kernel's inputs); ρ and α_pv given as one number
-    # stay 0-d (no array of a million copies): NumPy broadcasts them, and the Barus engine
-    # expands them (_full)
+    # one value per case, contiguous (the kernel's inputs); E*, R, η, ū(0), ρ and α_pv given
+    # as one number stay 0-d (no array of a million copies to write: 8 MB each per million
+    # cases): NumPy broadcasts them, the squeeze-out kernels read one value for all, and the
+    # Barus engine expands them (_full)
     return {k: a.reshape(()) if k in _SCALAR_OK and a.size == 1
             else np.ascontiguousarray(np.broadcast_to(a, shape).ravel(), dtype=np.float64)
             for k, a in arrs.items()}
 
 
 #: inputs of _inputs that may stay 0-d
-_SCALAR_OK = ("rho", "alpha_pv")
+_SCALAR_OK = ("E_star", "R", "eta", "u_start", "rho", "alpha_pv")
 
 
 def _full(b, n):
@@ -170,9 +171,11 @@ def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
     within the primitive's error (the exit's ū can differ by ~1e-8 relative where a near-start
     target changes which T(ū(0)) it pairs with)."""
     model = squeeze_model(tables, theory)
-    n = p_eval.size
-    us = b["u_start"] if "u_start" in b else np.full(n, np.nan)
-    cs = qk.Cases(np.ascontiguousarray(p_eval), b["E_star"], b["R"], b["eta"], us)
+    us = b["u_start"] if "u_start" in b else np.nan  # NaN: the default start
+    # E*, R, η and ū(0): one value per case or one for all (size 1, shared by every case)
+    shared = (np.ascontiguousarray(a, dtype=np.float64).reshape(-1)
+              for a in (b["E_star"], b["R"], b["eta"], us))
+    cs = qk.Cases(np.ascontiguousarray(p_eval), *shared)
     quad, _ = _check_method(method, 10, 1.0, None)
     names = _ratio_names(ratios)
     keep = [k for k, nm in enumerate(names) if want is None or nm in want]
@@ -240,11 +243,12 @@ def _inertia_columns(b, p_eval, u_used, h_rms, out):
     if u_used is None:
         out["t_star_inertia"] = np.full(p_eval.size, np.nan)
         return
+    t = np.empty(p_eval.size)  # in place from here: one array per million cases
     with np.errstate(invalid="ignore", divide="ignore"):
-        t = np.divide(u_used, h_rms)  # in place from here: one array per million cases
+        np.divide(u_used, h_rms, out=t)  # ū(0) one per case or one for all
         np.log(t, out=t)
         t *= tau
-    t[~(u_used > h_rms)] = np.nan
+    t[~np.broadcast_to(np.asarray(u_used) > h_rms, t.shape)] = np.nan
     out["t_star_inertia"] = t
 
 
