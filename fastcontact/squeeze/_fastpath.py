@@ -91,6 +91,14 @@ def _row_col(A, st, k):
     return st[1] * A[j0, k] + st[2] * A[j0 + 1, k] + st[3] * A[j0 + 2, k] + st[4] * A[j0 + 3, k]
 
 
+@njit(cache=True, inline="always")
+def _case_strides(cs):
+    """Index multipliers of the case arrays E, R, eta, us: 1 where they hold one value per
+    case, 0 where one value is shared by every case (size 1) — case i reads a[i * stride]."""
+    return (1 if cs.E.size > 1 else 0, 1 if cs.R.size > 1 else 0,
+            1 if cs.eta.size > 1 else 0, 1 if cs.us.size > 1 else 0)
+
+
 @njit(cache=True)
 def _start(pr, st, vinf, vs_in):
     """(v_start, T(v_start)) of a case: the default start (NaN in) or the given one."""
@@ -250,7 +258,7 @@ def _st_of(scr, c):
 
 
 @njit(parallel=True, cache=True)
-def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
+def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales):
     """method="fast": every case from the primitive (fall-back rows by quadrature).
 
     The records are unpacked into plain arrays before the parallel loop, and the per-case
@@ -262,8 +270,8 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
     Ratio targets (same z for every case) come from the row tables ``rt`` unless the start
     lies within GUARD_Z above them; there, and for Δu targets, both ends come from t_of_z (one
     interpolant: the difference is accurate and >= 0 however close the target is to the
-    start); ū at times from its inverse z_of_t. ``relax=False`` leaves t_relax, t_trap and
-    tau0 unwritten on the served rows (a caller that reports none of them saves the memory
+    start); ū at times from its inverse z_of_t. ``timescales=False`` leaves t_relax, t_trap
+    and tau0 unwritten on the served rows (a caller that reports none of them saves the memory
     traffic: 24 MB per million rows). The case arrays E, R, eta and us hold one value per case
     or one value for all (size 1: a study's shared modulus, radius, viscosity or start needs no
     array of a million copies)."""
@@ -285,11 +293,7 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
     R = cs.R
     eta = cs.eta
     us = cs.us
-    # index multipliers: 1 for one value per case, 0 for one value shared by every case
-    sE = 1 if E.size > 1 else 0
-    sR = 1 if R.size > 1 else 0
-    seta = 1 if eta.size > 1 else 0
-    sus = 1 if us.size > 1 else 0
+    sE, sR, seta, sus = _case_strides(cs)
     dvs = tg.dvs
     times = tg.times
     lnT = rt.lnT
@@ -314,7 +318,7 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
             tau = 3.0 * eta[i * seta] * Ri * Ri / (2.0 * h * h * p0[i])
             x0 = math.log(p0[i] / E[i * sE])
             vs_in = us[i * sus] / h
-            if relax:
+            if timescales:
                 tau0[i] = tau
             scr[c, _LIVE] = 0.0
             if not (x_lo <= x0 <= x_hi):
@@ -348,7 +352,7 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, relax):
             scr[c, _BAD] = 0.0 if 0.0 < tau < math.inf else 1.0
             u_inf[i] = vinf * h
             u_start[i] = vs * h
-            if relax:
+            if timescales:
                 t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
                 t_trap[i] = math.inf
             u_trap[i] = math.nan
@@ -403,10 +407,7 @@ def _tau0(tau, i, out):
 @njit(parallel=True, cache=True)
 def quad_kernel(tab, mp, cs, h, tg, quad, out):
     """method="quad": every case by per-case quadrature (one prange pass)."""
-    sE = 1 if cs.E.size > 1 else 0  # size-1 case arrays: shared by every case
-    sR = 1 if cs.R.size > 1 else 0
-    seta = 1 if cs.eta.size > 1 else 0
-    sus = 1 if cs.us.size > 1 else 0
+    sE, sR, seta, sus = _case_strides(cs)
     for i in prange(cs.p0.size):
         Ri = cs.R[i * sR]
         tau = 3.0 * cs.eta[i * seta] * Ri * Ri / (2.0 * h * h * cs.p0[i])

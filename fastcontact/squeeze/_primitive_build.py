@@ -192,8 +192,8 @@ def _lnkappa(pf, mp, vinf):
 @njit(parallel=True, cache=True)
 def _build_kernel(pf, mp, pr, glx, glw):
     """Fill the rows of ``pr`` (a :data:`Primitive` with its arrays allocated): per x0 node
-    ln v∞, ln κ, ln T and its z-derivatives at the ζ nodes (C), ln S (the slope below the grid) and
-    the default start's z; ``glx``, ``glw`` the Gauss–Legendre rule of each panel."""
+    ln v∞, ln κ, ln T and its z-derivatives at the ζ nodes (C), ln S (the slope below the
+    grid) and the default start's z; ``glx``, ``glw`` the Gauss–Legendre rule of each panel."""
     # the output arrays as locals, one per statement, outside the loop: a store inside a prange
     # body into an array taken from a record argument is lost (numba 0.6x parfor lowering)
     xn = pr.xn

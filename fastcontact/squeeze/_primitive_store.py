@@ -104,5 +104,6 @@ def read(path, expect_key=None):
     C = np.ascontiguousarray(np.stack([mats["L"], mats["D1"], mats["D2"]], axis=2))
     pr = Primitive(xn, *_index_map(xn), lagrange_denominators(xn), float(meta["z0"]),
                    float(meta["dz"]), nz, C,
-                   col["ln_v_inf"], col["ln_S"], col["z_start"], col["ln_kappa"], float(meta["v_ext"]), float(meta["c"]), float(meta["d"]))
+                   col["ln_v_inf"], col["ln_S"], col["z_start"], col["ln_kappa"],
+                   float(meta["v_ext"]), float(meta["c"]), float(meta["d"]))
     return pr, meta["info"]

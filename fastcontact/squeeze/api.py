@@ -118,13 +118,13 @@ def _cases(p0, E_star, R, eta, u_start):
     return qk.Cases(*flat)
 
 
-def run_cases(model, cs, ratios, dvs, times2d, method, quad, relax=True):
+def run_cases(model, cs, ratios, dvs, times2d, method, quad, timescales=True):
     """Evaluate the cases ``cs`` (reduced targets) into a fresh :data:`SqOut` record.
 
     ``times2d`` has shape (n_times, 1) (shared, ascending) or (n_times, n) (per case,
     ascending along axis 0). The case arrays E, R, eta and us of ``cs`` hold n values or one
-    shared by every case. ``relax=False``: a caller that reports none of t_relax, t_trap and
-    tau0 (the fast path then neither computes nor writes them: an interpolation per case and
+    shared by every case. ``timescales=False``: a caller that reports none of t_relax, t_trap
+    and tau0 (the fast path then neither computes nor writes them: an interpolation per case and
     24 MB per million rows); they come back as None."""
     n = cs.p0.size
     for name in ("E", "R", "eta", "us"):
@@ -146,8 +146,8 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad, relax=True):
         shared = n > 1 and (us.size == 1 or us.min() == us.max())
         rt = row_targets(pr, tg.ratios, tg.dvs, us[0] / model.h_rms if shared else math.nan)
         fast_kernel(model.tab, model.mp, pr, rt, fast_limit(model), cs, model.h_rms, tg, quad,
-                    out, bool(relax))
-    if not relax:  # not written on the rows the fast path serves: nothing to read
+                    out, bool(timescales))
+    if not timescales:  # not written on the rows the fast path serves: nothing to read
         out = out._replace(t_relax=None, t_trap=None, tau0=None)
     return out
 

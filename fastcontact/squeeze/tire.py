@@ -173,9 +173,9 @@ def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
     model = squeeze_model(tables, theory)
     us = b["u_start"] if "u_start" in b else np.nan  # NaN: the default start
     # E*, R, η and ū(0): one value per case or one for all (size 1, shared by every case)
-    shared = (np.ascontiguousarray(a, dtype=np.float64).reshape(-1)
-              for a in (b["E_star"], b["R"], b["eta"], us))
-    cs = qk.Cases(np.ascontiguousarray(p_eval), *shared)
+    rest = (np.ascontiguousarray(a, dtype=np.float64).reshape(-1)
+            for a in (b["E_star"], b["R"], b["eta"], us))
+    cs = qk.Cases(np.ascontiguousarray(p_eval), *rest)
     quad, _ = _check_method(method, 10, 1.0, None)
     names = _ratio_names(ratios)
     keep = [k for k, nm in enumerate(names) if want is None or nm in want]
@@ -184,7 +184,7 @@ def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
     exit_ = want is None or bool(want & _EXIT_COLUMNS)
     sq = run_cases(model, cs, r, np.array([du_complete / model.h_rms] if du else []),
                    np.ascontiguousarray(t_fp[None, :]) if exit_ else np.zeros((0, 1)), method,
-                   quad, relax=False)
+                   quad, timescales=False)
     out.update(u_inf=sq.u_inf, u_start=sq.u_start, t_star=sq.T[0],
                trapped=qk.trapped_mask(sq.status, sq.u_trap), u_trap=sq.u_trap,
                fluid_load_fraction=sq.flf, out_of_table=sq.status == qk.ST_OUT,
