@@ -52,7 +52,7 @@ from ..kernels.hermite import cubic_basis
 from ._primitive_eval import _index_map, _locate, one_plus_exp, t_slope_of_zv, z_of_t_at
 
 __all__ = ["API_FAST", "K_MAX", "SERIES_TOL", "BarusTable", "build", "h_coefficients", "h_series",
-           "series_order", "shift", "s_at", "s_value", "u_at_time"]
+           "series_order", "shift", "s_at", "s_value", "solve_u_at_time", "u_at_time"]
 
 #: highest series order of h; A = α p0 above API_FAST runs the per-case quadrature
 K_MAX = 48
@@ -204,7 +204,7 @@ def _inv_g(c, K, a):
     return 1.0 + a * p
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic):
     """v = ū/h_rms reached at reduced time tt after the start (T(start) = Ts, S(start) = Ss):
     the root of G(z) = T(z) + A S(v(z)) - (Ts + A Ss + tt) in z = ln(v/v∞ - 1), T the base
@@ -213,23 +213,71 @@ def u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic):
     Newton in z from the base solution z(Ts + tt) (one inverse), G' = T'(z)/g(a): each step
     is a forward evaluation of T and S, no inverse (~35 against ~90 ns). A step of at most
     Z_ACCEPT ends it, its result taken: the error left is of order |G''/G'| · Z_ACCEPT², at the
-    round-off of z."""
+    round-off of z. The iteration is safeguarded (:func:`solve_u_at_time`): it never returns
+    an unconverged z."""
+    return solve_u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic, NEWTON_STEPS)
+
+
+#: Newton steps of :func:`u_at_time` before it finishes by bisection on its bracket (never
+#: reached in the tests and benchmarks: 2–4 steps are the rule)
+NEWTON_STEPS = 40
+
+
+@njit(cache=True)
+def solve_u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic, newton_steps):
+    """:func:`u_at_time` with at most ``newton_steps`` Newton steps, then bisection.
+
+    The root is bracketed: T decreases with z and 1 <= 1/g(a) < 2 (g ∈ (1/2, 1],
+    :mod:`.viscosity`), so the base time T(z*) - Ts of the root lies in [tt/2, tt]:
+    z_b(Ts + tt) <= z* <= z_b(Ts + tt/2), z_b the base primitive's inverse. Newton starts at
+    the lower end; every evaluation narrows the bracket by the sign of G (G >= 0 below the
+    root), a step that would leave it is a bisection, and after ``newton_steps`` (or where G'
+    is 0) the bracket is bisected until it is Z_ACCEPT (1 + |z|) wide (at most ~60 halvings
+    from the widest bracket): the result is converged in every case, never a capped
+    iteration's last iterate."""
     if tt == 0.0:
         return vs
     if tt == math.inf:
         return vinf
     target = Ts + A * Ss + tt
     z = z_of_t_at(pr, st, vinf, Ts + tt, ic)
-    for _ in range(40):
-        if z == -math.inf or z != z:
-            break
+    if z == -math.inf:  # Ts + tt beyond the primitive: ū∞ to round-off
+        return vinf
+    if z != z:
+        return math.nan
+    lo = z
+    hi = math.inf
+    done = False
+    for _ in range(newton_steps):
         v = vinf * one_plus_exp(z)
         T, Tz = t_slope_of_zv(pr, st, vinf, z, v)
         s, y = s_value(bt, E, K, x0, v)
-        step = (T + A * s - target) / (Tz * _inv_g(c, K, A * (1.0 - y)))
-        z -= step
-        if abs(step) <= Z_ACCEPT * (1.0 + abs(z)):
+        f = T + A * s - target
+        if f >= 0.0:
+            lo = max(lo, z)
+        else:
+            hi = min(hi, z)
+        step = f / (Tz * _inv_g(c, K, A * (1.0 - y)))
+        zn = z - step
+        if not (lo <= zn <= hi):  # a step out of the bracket (or G' = 0): bisect
             break
+        z = zn
+        if abs(step) <= Z_ACCEPT * (1.0 + abs(z)):
+            done = True
+            break
+    if not done:
+        if hi == math.inf:
+            hi = z_of_t_at(pr, st, vinf, Ts + 0.5 * tt, ic)
+        for _ in range(200):
+            z = 0.5 * (lo + hi)
+            if hi - lo <= Z_ACCEPT * (1.0 + abs(z)):
+                break
+            v = vinf * one_plus_exp(z)
+            T = t_slope_of_zv(pr, st, vinf, z, v)[0]
+            if T + A * s_value(bt, E, K, x0, v)[0] - target >= 0.0:
+                lo = z
+            else:
+                hi = z
     return min(vinf * one_plus_exp(z), vs)
 
 
