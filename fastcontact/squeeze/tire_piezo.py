@@ -140,8 +140,8 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
         if method == "fast":
             from ._barus_fast import ratio_rows, tire_kernel
             setup = fast_setup(tables, theory, None)
-            tire_kernel(tab, sc, *setup, cs, al, tf, h, tg, *ratio_rows(setup[0], tg), quad, res,
-                        fast_scratch())
+            tire_kernel(tab, sc, *setup, cs, al, tf, h, tg, *ratio_rows(*setup[:3], tg), quad,
+                        res, fast_scratch())
         else:
             _tire_kernel(tab, sc, cs, al, tf, h, tg, quad, res)
     piezo = {"u_inf": ui, "u_start": us, "t_star": T[0], "trapped": st == _TRAPPED,

@@ -479,7 +479,7 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
         from ._barus_fast import ratio_rows, squeeze_kernel
         setup = fast_setup(tables, theory, sigma_trap)
         squeeze_kernel(tables.kernel_data(theory), sc, *setup, cs, flat[4], h, tg,
-                       *ratio_rows(setup[0], tg), quad, out, fast_scratch())
+                       *ratio_rows(*setup[:3], tg), quad, out, fast_scratch())
     else:
         _piezo_kernel(tables.kernel_data(theory), sc, cs, flat[4], h, tg, quad, out)
     df = _piezo_frame(flat, ratios, du, times, T, U, uinf, ustart, tau0, gs, status, theory,
