@@ -59,8 +59,12 @@ K_MAX = 48
 API_FAST = 0.6
 #: bound on Σ_{k>K} c_k A^(k+1) of the truncated series (relative error of t̃ it may cause)
 SERIES_TOL = 1e-13
-#: a Newton step in z of at most this (times 1 + |z|) ends the solve for ū at a time
-Z_ACCEPT = 1e-9
+#: a Newton step in z of at most this (times 1 + |z|) ends the solve for ū at a time: the
+#: error left after it is ~ |G''/(2G')| step², below 1e-10 in z (|G''/G'| is O(1) in z)
+Z_ACCEPT = 1e-5
+#: the bisection that finishes a solve the Newton steps did not (:func:`solve_u_at_time`)
+#: stops at a bracket this wide (times 1 + |z|)
+Z_BISECT = 1e-12
 #: Gauss–Legendre order of the cell integrals; sub-panels keep K_MAX |Δ ln π_c| <= SUB_SPAN
 CELL_ORDER = 8
 SUB_SPAN = 1.0
@@ -232,7 +236,7 @@ def solve_u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic, newton
     z_b(Ts + tt) <= z* <= z_b(Ts + tt/2), z_b the base primitive's inverse. Newton starts at
     the lower end; every evaluation narrows the bracket by the sign of G (G >= 0 below the
     root), a step that would leave it is a bisection, and after ``newton_steps`` (or where G'
-    is 0) the bracket is bisected until it is Z_ACCEPT (1 + |z|) wide (at most ~60 halvings
+    is 0) the bracket is bisected until it is Z_BISECT (1 + |z|) wide (at most ~70 halvings
     from the widest bracket): the result is converged in every case, never a capped
     iteration's last iterate."""
     if tt == 0.0:
@@ -270,7 +274,7 @@ def solve_u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt, ic, newton
             hi = z_of_t_at(pr, st, vinf, Ts + 0.5 * tt, ic)
         for _ in range(200):
             z = 0.5 * (lo + hi)
-            if hi - lo <= Z_ACCEPT * (1.0 + abs(z)):
+            if hi - lo <= Z_BISECT * (1.0 + abs(z)):
                 break
             v = vinf * one_plus_exp(z)
             T = t_slope_of_zv(pr, st, vinf, z, v)[0]
