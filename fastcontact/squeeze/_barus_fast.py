@@ -20,14 +20,13 @@ from numba import get_thread_id, njit, prange
 
 from ..kernels.borrow import borrowed
 
-from ..kernels.hermite import cubic_basis
-from ._barus_primitive import (BINOMIALS, K_MAX, BarusTable, s_at, s_value, series_order, shift,
-                               u_at_time)
+from ._barus_primitive import (BINOMIALS, K_MAX, BarusTable, s_at, s_cell, s_value,
+                               series_order, shift, u_at_time)
 from ._fastpath import ZTargets, _row_col, _target_time, row_targets, same_targets
 from ._kernels import Cases, Quad
 from ._kernels import _tail_int as qk_tail_int
-from ._primitive_eval import (Primitive, _locate, inverse_constants_ext, one_plus_exp,
-                              row_value, stencil, t_of_z, tail_top)
+from ._primitive_eval import (Primitive, inverse_constants_ext, one_plus_exp, row_value,
+                              stencil, t_of_z, tail_top)
 from .tire_piezo import _BELOW as TIRE_BELOW
 from .tire_piezo import _OK as TIRE_OK
 from .tire_piezo import TireOut, _tire_case
@@ -298,7 +297,7 @@ def _barus_rows_kernel(pr, bt, c, r1s, M, LS, Y):
 def _row_moments(bt, c, x0, v, u, m_out):
     """(ln σ̄(v), π_c(v)/π0) and c_m σ̄ M_m(v), m <= K_MAX, into m_out (u: scratch). Above
     v_ext the closed-form tail: y = 0, M_m = ∫_v^∞ dv'/σ̄_tail, σ̄_tail = w³ - c w, w = v + d
-    (as :func:`~._barus_primitive.s_at`)."""
+    (as :func:`~._barus_primitive.s_at`, whose cell interpolation :func:`s_cell` it shares)."""
     if v >= bt.v_ext:
         w = v + bt.d
         sig = w * w * w - bt.c * w
@@ -306,16 +305,8 @@ def _row_moments(bt, c, x0, v, u, m_out):
         for m in range(m_out.size):
             m_out[m] = c[m] * tail
         return math.log(sig), 0.0
-    s = math.log(v)
-    sn = bt.xn
-    i = _locate(bt, s)
-    if i < 0:
-        i = 0 if s < sn[0] else sn.size - 2
-    h = sn[i + 1] - sn[i]
-    h00, h10, h01, h11 = cubic_basis((s - sn[i]) / h, h)
-    ST, RHO, DRHO = bt.ST, bt.RHO, bt.DRHO
-    lnp = h00 * ST[i, 0] + h10 * ST[i, 1] + h01 * ST[i + 1, 0] + h11 * ST[i + 1, 1]
-    lns = h00 * ST[i, 2] + h10 * ST[i, 3] + h01 * ST[i + 1, 2] + h11 * ST[i + 1, 3]
+    i, h00, h10, h01, h11, lnp, lns = s_cell(bt, math.log(v))
+    RHO, DRHO = bt.RHO, bt.DRHO
     y = math.exp(lnp - x0)
     yp = 1.0
     for q in range(u.size):
