@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from .._core.validate import check_positive
+from ..kernels.readonly import readonly_fields
 from . import _leak
 
 __all__ = ["leak_uniform", "ECHO"]
@@ -76,7 +77,7 @@ def leak_uniform(sc, theory, p0, L, com, alpha_cj):
     lift = np.empty(n, dtype=np.bool_)
     perc = np.empty(n, dtype=np.bool_)
     open_in = np.empty(n)
-    _leak.uniform_rows(sc.tab, sc.rec, _leak.RingRows(*flat), theory == "critical_junction",
+    _leak.uniform_rows(sc.tab, sc.rec, readonly_fields(_leak.RingRows(*flat)), theory == "critical_junction",
                        float(sc.alpha_table),
                        _leak.RingOut(Q, st, p_a, lift, perc, open_in, echo), need)
     cols = {name: (echo[j] if need[j] else flat[j]) for j, name in enumerate(ECHO)}

@@ -59,6 +59,7 @@ from .._core.validate import check_positive
 from ..flow.piezoviscosity import ROELANDS_ETA_INF, check_law, roelands_parameters
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
+from ..kernels.readonly import readonly_fields
 from . import _panels
 from .context import (NEAR_LIFT_OFF, new_runs, seal_context, solve_profile_rows,
                       solver_options)
@@ -349,11 +350,11 @@ def _table_rows(tab, sc, sub, idx, bc, quad, out, done):
     xs, ws = gauss_legendre(CELL_SHORT_ORDER)
     short = Quad(xs, ws, CELL_WIDTH)
     if idx is None:
-        _cells_rows(tab, sc, UniformRows(*sub), bc, short, quad, out)
+        _cells_rows(tab, sc, readonly_fields(UniformRows(*sub)), bc, short, quad, out)
         done[:] = True
         return
     o = np.empty(idx.size)
-    _cells_rows(tab, sc, UniformRows(*(np.ascontiguousarray(a[idx]) for a in sub)), bc, short,
+    _cells_rows(tab, sc, readonly_fields(UniformRows(*(a[idx] for a in sub))), bc, short,
                 quad, o)
     out[idx] = o
     done[idx] = True
@@ -510,8 +511,8 @@ def _uniform_rows(tab, sc, v, law, quad_order, quad_width, memo, theory):
             if rest.size < out.size:
                 sub = [np.ascontiguousarray(a[rest]) for a in sub]
             order, starts = _sweep_order(sub)
-            rows = UniformRows(*(sub if order is None else
-                                 (np.ascontiguousarray(a[order]) for a in sub)))
+            rows = readonly_fields(UniformRows(*(sub if order is None else
+                                                 (a[order] for a in sub))))
             xs, ws = gauss_legendre(SHORT_ORDER)
             o = np.empty(rest.size)
             _uniform_sweep_kernel(tab, sc, rows, float(pr), quad,

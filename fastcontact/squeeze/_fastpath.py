@@ -17,6 +17,7 @@ from . import _kernels as qk
 from ._primitive_eval import inverse_constants, inverse_constants_ext, tail_top, z_of_t_at
 from .primitive import Primitive, first_row, row_value, stencil, t_of_z
 from ._primitive_eval import lagrange_denominators, one_plus_exp, t_of_zv
+from ..kernels.readonly import readonly_fields
 
 __all__ = ["fast_kernel", "history_kernel", "one_case_primitive", "RowTargets", "row_targets"]
 
@@ -433,11 +434,11 @@ def one_case_primitive(pr, x0):
         return None, st
     one = (0, 1.0, 0.0, 0.0, 0.0)
     xn = np.array([x0 - 1.0, x0, x0 + 1.0, x0 + 2.0])
-    pr1 = Primitive(xn, float(xn[0]), 1.0, np.arange(4.0), lagrange_denominators(xn), pr.z0,
-                    pr.dz, pr.nz,
-                    np.ascontiguousarray(_one_row(pr.C, st)), _one_row(pr.lnv, st),
-                    _one_row(pr.lnS, st), _one_row(pr.zs, st),
-                    _one_row(pr.lk, st), pr.v_ext, pr.c, pr.d)
+    pr1 = readonly_fields(Primitive(xn, float(xn[0]), 1.0, np.arange(4.0),
+                                    lagrange_denominators(xn), pr.z0, pr.dz, pr.nz,
+                                    _one_row(pr.C, st), _one_row(pr.lnv, st),
+                                    _one_row(pr.lnS, st), _one_row(pr.zs, st),
+                                    _one_row(pr.lk, st), pr.v_ext, pr.c, pr.d))
     return pr1, one
 
 

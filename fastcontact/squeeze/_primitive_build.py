@@ -17,6 +17,7 @@ from numba import njit, prange
 
 from ..kernels.hermite import cubic_basis
 from ..kernels.quadrature import gauss_legendre
+from ..kernels.readonly import readonly_fields
 from . import _kernels as qk
 from ._primitive_eval import (Primitive, _index_map, lagrange_denominators, one_plus_exp,
                               row_value, stencil, t_of_z)
@@ -322,6 +323,7 @@ def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, order=NODE_ORDER, check=True):
                    np.empty((nx, nz, 3)), *rows, float(mp.v_ext), float(mp.c), float(mp.d))
     glx, glw = gauss_legendre(order)
     _build_kernel(pf, mp, pr, glx, glw)
+    pr = readonly_fields(pr)  # written once above; every reader takes it read-only
     info = {"nx": int(nx), "nz": int(nz), "dxi": float(dxi), "build_seconds":
             _clock.perf_counter() - t0}
     if check:

@@ -14,6 +14,7 @@ import numpy as np
 
 from .._core.io import atomic_path
 from .._core.vocab import METADATA_KEY
+from ..kernels.readonly import readonly_fields
 from ._primitive_build import build
 from ._primitive_eval import Primitive, _index_map, lagrange_denominators
 
@@ -102,8 +103,8 @@ def read(path, expect_key=None):
                                     .reshape(-1, nz), dtype=np.float64) for k in ("L", "D1", "D2")}
     xn = col["x0"]
     C = np.ascontiguousarray(np.stack([mats["L"], mats["D1"], mats["D2"]], axis=2))
-    pr = Primitive(xn, *_index_map(xn), lagrange_denominators(xn), float(meta["z0"]),
-                   float(meta["dz"]), nz, C,
-                   col["ln_v_inf"], col["ln_S"], col["z_start"], col["ln_kappa"],
-                   float(meta["v_ext"]), float(meta["c"]), float(meta["d"]))
+    pr = readonly_fields(Primitive(xn, *_index_map(xn), lagrange_denominators(xn),
+                                   float(meta["z0"]), float(meta["dz"]), nz, C,
+                                   col["ln_v_inf"], col["ln_S"], col["z_start"], col["ln_kappa"],
+                                   float(meta["v_ext"]), float(meta["c"]), float(meta["d"])))
     return pr, meta["info"]

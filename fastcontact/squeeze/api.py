@@ -20,6 +20,7 @@ from .model import DEFAULT_P_START, squeeze_model
 from .primitive import fast_limit
 from .reduced import flat_separation
 from ..kernels.quadrature import gauss_legendre
+from ..kernels.readonly import readonly_fields
 
 __all__ = ["squeeze_out", "squeeze_history", "columns", "register_extension", "QUAD_ORDER",
            "QUAD_WIDTH", "STATUS_NAMES"]
@@ -115,7 +116,7 @@ def _cases(p0, E_star, R, eta, u_start):
                          f"{[np.shape(a) for a in arrs]} do not broadcast") from None
     flat = [np.ascontiguousarray(np.broadcast_to(a, shape).ravel(), dtype=np.float64)
             for a in arrs]
-    return qk.Cases(*flat)
+    return readonly_fields(qk.Cases(*flat))
 
 
 def run_cases(model, cs, ratios, dvs, times2d, method, quad, timescales=True):
@@ -134,9 +135,9 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad, timescales=True):
     nt = 1 + ratios.size + dvs.size
     out = qk.SqOut(np.empty((nt, n)), np.empty((times2d.shape[0], n)), *(np.empty(n) for _ in
                    range(7)), np.empty(n, dtype=np.int8))
-    tg = qk.Targets(np.ascontiguousarray(ratios, dtype=np.float64),
-                    np.ascontiguousarray(dvs, dtype=np.float64),
-                    np.ascontiguousarray(times2d, dtype=np.float64))
+    tg = readonly_fields(qk.Targets(np.ascontiguousarray(ratios, dtype=np.float64),
+                                    np.ascontiguousarray(dvs, dtype=np.float64),
+                                    np.ascontiguousarray(times2d, dtype=np.float64)))
     if method == "quad":
         quad_kernel(model.tab, model.mp, cs, model.h_rms, tg, quad, out)
     else:

@@ -45,6 +45,7 @@ import pandas as pd
 
 from .._core.validate import as_float_array, check_positive
 from .._core.vocab import DEFAULT_THEORY, column_name
+from ..kernels.readonly import readonly_fields
 from . import _kernels as qk
 from .api import _check_method, attrs, run_cases, squeeze_history, squeeze_out, status_column
 from .model import squeeze_model
@@ -175,7 +176,7 @@ def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
     # E*, R, η and ū(0): one value per case or one for all (size 1, shared by every case)
     rest = (np.ascontiguousarray(a, dtype=np.float64).reshape(-1)
             for a in (b["E_star"], b["R"], b["eta"], us))
-    cs = qk.Cases(np.ascontiguousarray(p_eval), *rest)
+    cs = readonly_fields(qk.Cases(np.ascontiguousarray(p_eval), *rest))
     quad, _ = _check_method(method, 10, 1.0, None)
     names = _ratio_names(ratios)
     keep = [k for k, nm in enumerate(names) if want is None or nm in want]

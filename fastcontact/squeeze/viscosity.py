@@ -36,6 +36,7 @@ from .api import register_extension, squeeze_out
 from .model import squeeze_model
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
+from ..kernels.readonly import readonly, readonly_fields
 from ._kernels import Cases, Quad, state_gap
 from ._kernels import _lnv_of_lnp as qk_lnv_of_lnp
 from ._kernels import _state as qk_state
@@ -472,16 +473,17 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     uinf, ustart, tau0, gs = (np.empty(n) for _ in range(4))
     status = np.empty(n, dtype=np.int8)
     x, w = gauss_legendre(qo)
-    cs = Cases(flat[0], flat[1], flat[2], flat[3], flat[5])
-    tg = BarusTargets(vr, dv, times)
+    cs = readonly_fields(Cases(flat[0], flat[1], flat[2], flat[3], flat[5]))
+    al = readonly(flat[4])
+    tg = readonly_fields(BarusTargets(vr, dv, times))
     quad, out = Quad(x, w, width), BarusOut(T, U, uinf, ustart, tau0, gs, status)
     if method == "fast":
         from ._barus_fast import ratio_rows, squeeze_kernel
         setup = fast_setup(tables, theory, sigma_trap)
-        squeeze_kernel(tables.kernel_data(theory), sc, *setup, cs, flat[4], h, tg,
+        squeeze_kernel(tables.kernel_data(theory), sc, *setup, cs, al, h, tg,
                        *ratio_rows(*setup[:3], tg), quad, out, fast_scratch())
     else:
-        _piezo_kernel(tables.kernel_data(theory), sc, cs, flat[4], h, tg, quad, out)
+        _piezo_kernel(tables.kernel_data(theory), sc, cs, al, h, tg, quad, out)
     df = _piezo_frame(flat, ratios, du, times, T, U, uinf, ustart, tau0, gs, status, theory,
                       method)
     if method == "fast":

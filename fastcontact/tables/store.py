@@ -19,6 +19,7 @@ from ..flow.conductivity import check_theory
 from ..kernels.locate import Grid, build_bucket_map
 from ..kernels.lookup import TableKernel, eval_p, eval_sigma, eval_u
 from ..surface.psd import PSD, psd_from_dict
+from ..kernels.readonly import readonly_fields
 
 __all__ = ["Tables", "TableRangeError", "SCHEMA_VERSION", "UNITS", "REFERENCES", "column_unit"]
 
@@ -200,11 +201,11 @@ class Tables:
             lnsig, n_open = _lnsig_and_open(self.data[f"sigma_{theory}"])
             p_perc = self.info["percolation_p_over_E"][theory]
             lnp_perc = math.log(p_perc) if np.isfinite(p_perc) else math.inf
-            self._kernel_cache[theory] = TableKernel(
+            self._kernel_cache[theory] = readonly_fields(TableKernel(
                 self._ln_p, self._lnu, self._dlnu, lnsig,
                 np.ascontiguousarray(self.data[f"dlnsigma_{theory}"], dtype=np.float64),
                 float(lnp_perc), n_open, *self._bp, *self._bu, self._d2lnu,
-                np.ascontiguousarray(self.data[f"d2lnsigma_{theory}"], dtype=np.float64))
+                np.ascontiguousarray(self.data[f"d2lnsigma_{theory}"], dtype=np.float64)))
         return self._kernel_cache[theory]
 
     # ------------------------------------------------------------------ range checks
