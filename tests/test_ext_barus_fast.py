@@ -15,12 +15,15 @@ import sys
 
 import numpy as np
 import pytest
+from numba import njit
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from reference.ext_reynolds import squeeze_time  # noqa: E402
 
 import fastcontact as fc  # noqa: E402
 from fastcontact.squeeze import _barus_primitive as bp  # noqa: E402
+from fastcontact.squeeze._primitive_eval import (inverse_constants, row_value,  # noqa: E402
+                                                 stencil, t_of_z)
 from fastcontact.squeeze.model import squeeze_model  # noqa: E402
 from fastcontact.squeeze.tire import tire_footprint  # noqa: E402
 from fastcontact.squeeze.viscosity import squeeze_out_piezo  # noqa: E402
@@ -297,24 +300,19 @@ def test_thick_films_above_the_flat_film_tail(tables):
     assert np.all(ef.u_exit < us)
 
 
-def _bisection_case():
-    from numba import njit
-
-    from fastcontact.squeeze._primitive_eval import (inverse_constants, row_value, stencil,
-                                                     t_of_z)
-
-    @njit
-    def one(pr, bt, c, x0, A, vs, tt, steps):
-        st = stencil(pr, x0)
-        K = bp.series_order(c, A)
-        E = np.empty(bp.K_MAX + 1)
-        bp.shift(c, A, K, E)
-        vinf = math.exp(row_value(pr.lnv, st))
-        Ts = t_of_z(pr, st, vinf, math.log(vs / vinf - 1.0))
-        Ss = bp.s_value(bt, E, K, x0, vs)[0]
-        return bp.solve_u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt,
-                                  inverse_constants(pr, st), steps)
-    return one
+@njit(cache=True)  # module level: compiled once and cached (a closure recompiles per call)
+def _bisection_case(pr, bt, c, x0, A, vs, tt, steps):
+    """ū/h_rms at the reduced time ``tt`` after ``vs`` by the fast path's solve, its Newton
+    steps capped at ``steps``."""
+    st = stencil(pr, x0)
+    K = bp.series_order(c, A)
+    E = np.empty(bp.K_MAX + 1)
+    bp.shift(c, A, K, E)
+    vinf = math.exp(row_value(pr.lnv, st))
+    Ts = t_of_z(pr, st, vinf, math.log(vs / vinf - 1.0))
+    Ss = bp.s_value(bt, E, K, x0, vs)[0]
+    return bp.solve_u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, tt,
+                              inverse_constants(pr, st), steps)
 
 
 @pytest.mark.parametrize("theory", ["critical_junction", "emt"])
@@ -325,7 +323,6 @@ def test_u_at_time_converges_without_newton(tables, theory):
     solve never hands out an unconverged iterate."""
     from fastcontact.squeeze.viscosity import fast_setup
     pr, bt, c, _x_fast = fast_setup(tables, theory, None)
-    one = _bisection_case()
     h = tables.h_rms
     p0s, As = np.array([3e3, 5e4, 2e5]), np.array([1e-3, 0.3, 0.6])
     times = np.array([1e-5, 1e-3, 0.1, 3.0])
@@ -341,7 +338,7 @@ def test_u_at_time_converges_without_newton(tables, theory):
             for k, t in enumerate(times):
                 duq = r[names[k]] - r.u_inf
                 for steps in (0, 1, bp.NEWTON_STEPS):
-                    v = one(pr, bt, c, math.log(p0 / E_STAR), A, 1e-4 / h, t / tau, steps)
+                    v = _bisection_case(pr, bt, c, math.log(p0 / E_STAR), A, 1e-4 / h, t / tau, steps)
                     du = v * h - r.u_inf
                     assert abs(du - duq) <= max(2e-7 * duq, 1e-8 * r.u_inf), \
                         (p0, A, t, steps, du, duq)
