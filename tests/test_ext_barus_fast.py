@@ -338,7 +338,8 @@ def test_u_at_time_converges_without_newton(tables, theory):
             for k, t in enumerate(times):
                 duq = r[names[k]] - r.u_inf
                 for steps in (0, 1, bp.NEWTON_STEPS):
-                    v = _bisection_case(pr, bt, c, math.log(p0 / E_STAR), A, 1e-4 / h, t / tau, steps)
+                    v = _bisection_case(pr, bt, c, math.log(p0 / E_STAR), A, 1e-4 / h,
+                                        t / tau, steps)
                     du = v * h - r.u_inf
                     assert abs(du - duq) <= max(2e-7 * duq, 1e-8 * r.u_inf), \
                         (p0, A, t, steps, du, duq)

@@ -306,6 +306,7 @@ def test_seal_barus_cells_match_per_row(tables, theory):
     the table too; a few rows equal the separate BVP reference to 1e-8; a group whose weight
     e^{α p_cont} would span more than e^200 keeps the per-row path."""
     from fastcontact.kernels.quadrature import gauss_legendre
+    from fastcontact.kernels.readonly import readonly_fields
     from fastcontact.seal._piezo_kernels import Quad, UniformRows, _uniform_kernel
     import fastcontact.seal.viscosity as sv
 
@@ -340,7 +341,7 @@ def test_seal_barus_cells_match_per_row(tables, theory):
     sweep, calls = _table_calls(tables, dict(kw, p0=p_s, dp=dps, p_b=0.0, alpha_pv=2e-6))
     assert len(calls) == 1 and calls[0]["rows"].p0.size == m
     pick = np.arange(0, m, 97)
-    rows_s = UniformRows(*(np.ascontiguousarray(a[pick]) for a in calls[0]["rows"]))
+    rows_s = readonly_fields(UniformRows(*(a[pick] for a in calls[0]["rows"])))  # as passed
     ref_s = np.empty(pick.size)
     _uniform_kernel(c["tab"], c["sc"], rows_s, 0.0, Quad(x, w, 0.05), ref_s)
     err_s = np.max(np.abs(calls[0]["out"][pick] / ref_s - 1))
@@ -349,8 +350,8 @@ def test_seal_barus_cells_match_per_row(tables, theory):
     # the whole batch (table rows and per-row rows) against the same reference, through Q
     # (every row back in its place); the per-row default rule (panels 0.5 wide, not split at
     # the σ̄ table's nodes) is off by up to ~2e-8 next to percolation (measured 1.9e-8)
-    sub = UniformRows(*(np.ascontiguousarray(a, dtype=np.float64) for a in (
-        p0, np.full(n, 5e-3), pb + dp, pb, np.full(n, E_STAR), al, np.zeros(n))))
+    sub = readonly_fields(UniformRows(*(np.ascontiguousarray(a, dtype=np.float64) for a in (
+        p0, np.full(n, 5e-3), pb + dp, pb, np.full(n, E_STAR), al, np.zeros(n)))))
     ref_all = np.empty(n)
     _uniform_kernel(c["tab"], c["sc"], sub, 0.0, Quad(x, w, 0.05), ref_all)
     q_ref = L_Y * ref_all * float(tables.h_rms) ** 3 / (12.0 * ETA)
@@ -470,6 +471,7 @@ def test_seal_run_table_matches_per_row(tables, theory):
     the same kernel with 10x narrower panels to 5e-8 (its panels are not split at the σ̄ nodes
     next to percolation), Q rising with Δp."""
     from fastcontact.kernels.quadrature import gauss_legendre
+    from fastcontact.kernels.readonly import readonly_fields
     from fastcontact.seal._piezo_kernels import Quad, _uniform_kernel
     import fastcontact.seal.viscosity as sv
 
@@ -491,7 +493,7 @@ def test_seal_run_table_matches_per_row(tables, theory):
     c = calls[0]
     x, w = gauss_legendre(16)
     pick = np.arange(0, m, 61)
-    rows = type(c["rows"])(*(np.ascontiguousarray(a[pick]) for a in c["rows"]))
+    rows = readonly_fields(type(c["rows"])(*(a[pick] for a in c["rows"])))  # as passed
     ref = np.empty(pick.size)
     pr = float(c["bc"].pr)
     _uniform_kernel(c["tab"], c["sc"], rows, pr, Quad(x, w, 0.005), ref)
@@ -501,9 +503,9 @@ def test_seal_run_table_matches_per_row(tables, theory):
     # reference through Q
     chk = np.union1d(np.flatnonzero(p0 != p_s), np.arange(0, p0.size, 37))
     k = chk.size
-    sub = type(c["rows"])(*(np.ascontiguousarray(a, dtype=np.float64) for a in (
+    sub = readonly_fields(type(c["rows"])(*(np.ascontiguousarray(a, dtype=np.float64) for a in (
         p0[chk], np.full(k, 5e-3), dp[chk], np.zeros(k), np.full(k, E_STAR),
-        np.full(k, c["bc"].A), np.full(k, c["bc"].Z))))
+        np.full(k, c["bc"].A), np.full(k, c["bc"].Z)))))
     ref_all = np.empty(k)
     _uniform_kernel(c["tab"], c["sc"], sub, pr, Quad(x, w, 0.05), ref_all)
     q_ref = L_Y * ref_all * float(tables.h_rms) ** 3 / (12.0 * ETA)

@@ -55,9 +55,26 @@ def _parallel_kernels():
             and v.targetoptions.get("parallel")]
 
 
+def _differences(signatures):
+    """Where signatures differ: {argument position: [its type in each signature]}, a named
+    tuple's fields expanded (position "3.4" is field 4 of argument 3)."""
+    def flat(sig):
+        out = {}
+        for i, t in enumerate(sig):
+            items = getattr(t, "types", None) if hasattr(t, "fields") else None
+            if items is None:
+                out[str(i)] = str(t)
+            else:
+                out.update({f"{i}.{j}": str(u) for j, u in enumerate(items)})
+        return out
+    flats = [flat(s) for s in signatures]
+    keys = sorted(set().union(*flats))
+    return {k: [f.get(k) for f in flats] for k in keys if len({f.get(k) for f in flats}) > 1}
+
+
 def _one_signature(*reached):
     """``reached`` compiled (or loaded) exactly once; no parallel kernel more than once."""
-    many = {f"{k.__module__}.{k.py_func.__qualname__}": [str(s) for s in k.signatures]
+    many = {f"{k.__module__}.{k.py_func.__qualname__}": _differences(k.signatures)
             for k in set(_parallel_kernels()) | set(reached) if len(k.signatures) > 1}
     assert not many, many
     missed = [k.py_func.__qualname__ for k in reached if len(k.signatures) != 1]

@@ -77,8 +77,8 @@ def leak_uniform(sc, theory, p0, L, com, alpha_cj):
     lift = np.empty(n, dtype=np.bool_)
     perc = np.empty(n, dtype=np.bool_)
     open_in = np.empty(n)
-    _leak.uniform_rows(sc.tab, sc.rec, readonly_fields(_leak.RingRows(*flat)), theory == "critical_junction",
-                       float(sc.alpha_table),
+    _leak.uniform_rows(sc.tab, sc.rec, readonly_fields(_leak.RingRows(*flat)),
+                       theory == "critical_junction", float(sc.alpha_table),
                        _leak.RingOut(Q, st, p_a, lift, perc, open_in, echo), need)
     cols = {name: (echo[j] if need[j] else flat[j]) for j, name in enumerate(ECHO)}
     cols.update(Q=Q, lift_off=lift, percolated=perc, status=st, p_a=p_a, open_inlet=open_in,
