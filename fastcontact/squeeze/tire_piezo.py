@@ -28,7 +28,7 @@ import pandas as pd
 from numba import njit, prange
 
 from ..kernels.quadrature import gauss_legendre
-from ..kernels.readonly import readonly_fields
+from ..kernels.readonly import readonly, readonly_fields
 from ._kernels import Cases, Quad
 from .api import STATUS_NAMES
 from .viscosity import (BarusTargets, _case_head, _case_start, _lnv_of_lnp, _scalars,
@@ -132,10 +132,10 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
     if m:
         us_in = b["u_start"][sel] if "u_start" in b else np.full(m, np.nan)
         x, w = gauss_legendre(QUAD_ORDER)
-        p, E, R, eta, al, u0, tf = [np.ascontiguousarray(a, dtype=np.float64) for a in
+        p, E, R, eta, al, u0, tf = [readonly(a) for a in
                                     (p_eval[sel], b["E_star"][sel], b["R"][sel], b["eta"][sel],
                                      alpha[sel], us_in, t_fp[sel] if exit_ else t_fp[:0])]
-        cs = readonly_fields(Cases(p, E, R, eta, u0))
+        cs = Cases(p, E, R, eta, u0)
         tg = readonly_fields(BarusTargets(vr, dv, np.empty(0)))
         quad, res = Quad(x, w, QUAD_WIDTH), TireOut(T, ue, ui, us, ut, fl, st)
         tab, sc = tables.kernel_data(theory), _scalars(tables, theory, None)
