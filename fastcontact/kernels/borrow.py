@@ -15,6 +15,13 @@ numba's increment and decrement test for NULL and do nothing. The view does not 
 so it must not outlive the record it came from: take it at the top of a kernel from a record
 the kernel received as an argument, use it inside that kernel (and its inlined helpers and
 ``prange`` bodies), never return or store it.
+
+A record does not stay borrowed across a parallel loop: numba's parfor lowering passes the
+arrays a ``prange`` body uses to the loop's worker function with their reference counts. The
+parallel kernels therefore hand blocks of cases to a plain function that borrows its records
+at its top (e.g. :func:`fastcontact.squeeze._fastpath.fast_kernel`): measured on the Barus
+squeeze-out, one thread, 2e5 cases, 551 ns per case with the records borrowed only before the
+loop, 288 ns borrowed in the block function.
 """
 from __future__ import annotations
 

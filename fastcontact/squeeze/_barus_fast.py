@@ -22,7 +22,7 @@ from ..kernels.borrow import borrowed
 
 from ._barus_primitive import (BINOMIALS, K_MAX, BarusTable, s_at, s_cell, s_value,
                                series_order, shift, u_at_time)
-from ._fastpath import ZTargets, _row_col, _target_time, row_targets, same_targets
+from ._fastpath import BLOCK, ZTargets, _row_col, _target_time, row_targets, same_targets
 from ._kernels import Cases, Quad
 from ._kernels import _tail_int as qk_tail_int
 from ._primitive_eval import (Primitive, inverse_constants_ext, one_plus_exp, row_value,
@@ -126,11 +126,34 @@ def _target_times(bt, pr, sb, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau
 
 
 @njit(parallel=True, cache=True)
-def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, quad, out,
-                 scratch):
-    """The case body inline (a call per case with ~40 arguments cost about as much as the
-    case); stores go to the output arrays taken one per statement before the loop (a store
-    into a record's array inside a prange body is lost in numba 0.6x's parfor lowering)."""
+def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, quad, out,
+                   scratch):
+    """Barus squeeze-out of every case (``cs`` :class:`~._kernels.Cases`, α [1/Pa] apart)
+    into ``out`` (:data:`~.viscosity.BarusOut`): the primitive where it serves the case, else
+    the per-case quadrature (``quad``). ``scratch`` (threads, K_MAX + 1): one row of series
+    coefficients per thread. ``zt``, ``lnTs``, ``sb``: :func:`ratio_rows` of ``tg``.
+
+    Blocks of :data:`~._fastpath.BLOCK` cases in parallel, each one call of
+    :func:`_squeeze_block`: the case body is compiled as a plain function, outside numba's
+    parfor passes (whose cost grows faster than the body: the body inline in this loop took
+    ~60 s of compiling on 2 cores; a call per block costs nothing measurable)."""
+    n = cs.p0.size
+    for blk in prange((n + BLOCK - 1) // BLOCK):
+        _squeeze_block(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, quad, out,
+                       scratch, blk * BLOCK, min(blk * BLOCK + BLOCK, n))
+
+
+@njit(cache=True)
+def _squeeze_block(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, quad, out,
+                   scratch, b0, b1):
+    """Cases b0 <= i < b1 of :func:`squeeze_kernel`.
+
+    The records are borrowed here (:mod:`fastcontact.kernels.borrow`): each copy of a record
+    into an inline helper would count references on every array in it (most of a case's time,
+    contended between threads), and records reach this function from the parallel loop with
+    their counts, whatever the caller of the loop passed."""
+    (tab, sc, pr, bt, c, cs, alpha, tg, zt, lnTs, sb, quad, out, scratch) = borrowed(
+        (tab, sc, pr, bt, c, cs, alpha, tg, zt, lnTs, sb, quad, out, scratch))
     T_out = out.T
     U_out = out.U
     u_inf = out.u_inf
@@ -144,7 +167,7 @@ def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, qua
     # or a time needs S off the rows
     need_E = tg.dvs.size > 0 or times.size > 0
     T_ext = tail_top(pr)  # T at v_ext, the same for every case
-    for i in prange(cs.p0.size):
+    for i in range(b0, b1):
         x0, tau, A, K, st = _served(pr, sc, c, cs, alpha, h, x_fast, i)
         if K < 0:
             _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out)
@@ -173,28 +196,26 @@ def _squeeze_par(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, qua
                                         times[k] / tau, ic) * h
 
 
-@njit(cache=True)
-def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, quad, out,
-                   scratch):
-    """Barus squeeze-out of every case (``cs`` :class:`~._kernels.Cases`, α [1/Pa] apart)
-    into ``out`` (:data:`~.viscosity.BarusOut`): the primitive where it serves the case, else
-    the per-case quadrature (``quad``). ``scratch`` (threads, K_MAX + 1): one row of series
-    coefficients per thread. ``zt``, ``lnTs``, ``sb``: :func:`ratio_rows` of ``tg``.
-
-    The records reach the per-case helper as borrowed views (:mod:`fastcontact.kernels.borrow`;
-    passed by value each call costs two contended atomic reference counts per array, most of
-    a case's time). They are borrowed here and handed to the parallel loop as arguments:
-    numba's parfor lowering rebuilds a namedtuple captured by a prange body from the
-    definition of its variable, which must be an argument or the class itself."""
-    _squeeze_par(borrowed(tab), borrowed(sc), borrowed(pr), borrowed(bt), borrowed(c), x_fast,
-                 borrowed(cs), borrowed(alpha), h, borrowed(tg), borrowed(zt), borrowed(lnTs),
-                 borrowed(sb), borrowed(quad), borrowed(out), borrowed(scratch))
-
-
 @njit(parallel=True, cache=True)
-def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb, quad, out,
-              scratch):
-    """The case body inline, as :func:`_squeeze_par`."""
+def tire_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb, quad, out,
+                scratch):
+    """Barus tire footprint of every case (footprint time t_fp [s] apart) into ``out``
+    (:data:`~.tire_piezo.TireOut`): targets and ū at t_fp (t_fp of size 0: not asked for,
+    u_exit NaN) from the primitive where it serves the case, else the per-case quadrature;
+    blocks of cases in parallel as :func:`squeeze_kernel` (:func:`_tire_block`)."""
+    n = cs.p0.size
+    for blk in prange((n + BLOCK - 1) // BLOCK):
+        _tire_block(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb, quad,
+                    out, scratch, blk * BLOCK, min(blk * BLOCK + BLOCK, n))
+
+
+@njit(cache=True)
+def _tire_block(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb, quad, out,
+                scratch, b0, b1):
+    """Cases b0 <= i < b1 of :func:`tire_kernel` (records borrowed as in
+    :func:`_squeeze_block`)."""
+    (tab, sc, pr, bt, c, cs, alpha, t_fp, tg, zt, lnTs, sb, quad, out, scratch) = borrowed(
+        (tab, sc, pr, bt, c, cs, alpha, t_fp, tg, zt, lnTs, sb, quad, out, scratch))
     T_out = out.T
     u_exit = out.u_exit
     u_inf = out.u_inf
@@ -205,7 +226,7 @@ def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb, 
     us = cs.us
     nT = T_out.shape[0]
     T_ext = tail_top(pr)  # T at v_ext, the same for every case
-    for i in prange(cs.p0.size):
+    for i in range(b0, b1):
         x0, tau, A, K, st = _served(pr, sc, c, cs, alpha, h, x_fast, i)
         if K < 0:
             _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out)
@@ -235,18 +256,6 @@ def _tire_par(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb, 
         ic = inverse_constants_ext(pr, st, T_ext)
         u_exit[i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, t_fp[i] / tau,
                               ic) * h
-
-
-@njit(cache=True)
-def tire_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb, quad, out,
-                scratch):
-    """Barus tire footprint of every case (footprint time t_fp [s] apart) into ``out``
-    (:data:`~.tire_piezo.TireOut`): targets and ū at t_fp (t_fp of size 0: not asked for,
-    u_exit NaN) from the primitive where it serves the case, else the per-case quadrature
-    (records borrowed as in :func:`squeeze_kernel`)."""
-    _tire_par(borrowed(tab), borrowed(sc), borrowed(pr), borrowed(bt), borrowed(c), x_fast,
-              borrowed(cs), borrowed(alpha), borrowed(t_fp), h, borrowed(tg), borrowed(zt),
-              borrowed(lnTs), borrowed(sb), borrowed(quad), borrowed(out), borrowed(scratch))
 
 
 def ratio_rows(pr, bt, c, tg):

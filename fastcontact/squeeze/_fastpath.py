@@ -17,6 +17,7 @@ from . import _kernels as qk
 from ._primitive_eval import inverse_constants, inverse_constants_ext, tail_top, z_of_t_at
 from .primitive import Primitive, first_row, row_value, stencil, t_of_z
 from ._primitive_eval import lagrange_denominators, one_plus_exp, t_of_zv
+from ..kernels.borrow import borrowed
 from ..kernels.readonly import readonly_fields
 
 __all__ = ["fast_kernel", "history_kernel", "one_case_primitive", "RowTargets", "row_targets"]
@@ -57,8 +58,26 @@ def _row_stencil(pr, j):
 
 @njit(parallel=True, cache=True)
 def _row_targets_kernel(pr, ratios, dvs, vsh, lnT, lnTs, lnTv):
+    """Blocks of rows in parallel, each one call of :func:`_row_targets_rows` (compiled
+    outside numba's parfor passes: its inline interpolants in this loop cost ~10 s of
+    compiling)."""
+    n = pr.xn.size
+    for b in prange((n + _ROWS - 1) // _ROWS):
+        _row_targets_rows(pr, ratios, dvs, vsh, lnT, lnTs, lnTv, b * _ROWS,
+                          min(b * _ROWS + _ROWS, n))
+
+
+#: rows per call of :func:`_row_targets_rows`
+_ROWS = 32
+
+
+@njit(cache=True)
+def _row_targets_rows(pr, ratios, dvs, vsh, lnT, lnTs, lnTv, j0, j1):
+    """Rows j0 <= j < j1 of :func:`_row_targets_kernel` (the primitive borrowed: a record
+    crossing the parallel loop arrives with its reference counts)."""
+    pr = borrowed(pr)
     nr = ratios.size
-    for j in prange(pr.xn.size):
+    for j in range(j0, j1):
         st = _row_stencil(pr, j)
         vinf = math.exp(pr.lnv[j])
         lnTs[j] = math.log(t_of_z(pr, st, vinf, pr.zs[j]))
@@ -262,23 +281,40 @@ def _st_of(scr, c):
 def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales):
     """method="fast": every case from the primitive (fall-back rows by quadrature).
 
-    The records are unpacked into plain arrays before the parallel loop, and the per-case
-    work is inline in its body (helpers with ``inline="always"``): a call per case with the
-    records by value costs ten times the arithmetic. Each parallel iteration takes a block of
-    :data:`BLOCK` cases through the stages (stencil and v∞; start; each time target; each ū
-    at a time; status) one after the other: within a stage the cases are independent, so the
-    CPU overlaps them (a case alone is latency-bound: ×1.5–1.7 measured on the start stage).
-    Ratio targets (same z for every case) come from the row tables ``rt`` unless the start
-    lies within GUARD_Z above them; there, and for Δu targets, both ends come from t_of_z (one
-    interpolant: the difference is accurate and >= 0 however close the target is to the
-    start); ū at times from its inverse z_of_t. ``timescales=False`` leaves t_relax, t_trap
-    and tau0 unwritten on the served rows (a caller that reports none of them saves the memory
-    traffic: 24 MB per million rows). The case arrays E, R, eta and us hold one value per case
-    or one value for all (size 1: a study's shared modulus, radius, viscosity or start needs no
-    array of a million copies)."""
-    # one field per statement: with tuple unpacking (a, b = rec.a, rec.b) numba 0.6x's parfor
-    # lowering keeps only the first array's writes, and a record-field setitem in the loop
-    # body (rec.a[i] = x) is lost as well
+    Each parallel iteration takes a block of :data:`BLOCK` cases (:func:`_fast_block`) through
+    the stages (stencil and v∞; start; each time target; each ū at a time; status) one after
+    the other: within a stage the cases are independent, so the CPU overlaps them (a case
+    alone is latency-bound: ×1.5–1.7 measured on the start stage). Ratio targets (same z for
+    every case) come from the row tables ``rt`` unless the start lies within GUARD_Z above
+    them; there, and for Δu targets, both ends come from t_of_z (one interpolant: the
+    difference is accurate and >= 0 however close the target is to the start); ū at times
+    from its inverse z_of_t. ``timescales=False`` leaves t_relax, t_trap and tau0 unwritten on
+    the served rows (a caller that reports none of them saves the memory traffic: 24 MB per
+    million rows). The case arrays E, R, eta and us hold one value per case or one value for
+    all (size 1: a study's shared modulus, radius, viscosity or start needs no array of a
+    million copies).
+
+    The parallel body is one call per block: the per-case work (its helpers inline) is
+    compiled as a plain function, outside numba's parfor passes, whose cost grows faster than
+    the body (a body of the whole block inline here took ~65 s of compiling on 2 cores; a call
+    per block of 128 cases costs nothing measurable)."""
+    nr = tg.ratios.size
+    r1s = np.empty(1 + nr)  # ū/ū∞ - 1 of t_star and the ratios, and its log
+    r1s[0] = 0.01
+    r1s[1:] = tg.ratios - 1.0
+    zt = ZTargets(r1s, np.log(r1s), tg.dvs, rt.lnT, same_targets(r1s, tg.dvs))
+    n = cs.p0.size
+    for blk in prange((n + BLOCK - 1) // BLOCK):
+        _fast_block(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales, zt,
+                    blk * BLOCK, min(blk * BLOCK + BLOCK, n))
+
+
+@njit(cache=True)
+def _fast_block(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales, zt, b0, b1):
+    """Cases b0 <= i < b1 of :func:`fast_kernel`, stage by stage (``zt`` its
+    :data:`ZTargets`). The records are borrowed (:mod:`fastcontact.kernels.borrow`): each
+    inline helper's copy of a record would otherwise count references on every array in it."""
+    tab, mp, pr, rt, cs, tg, quad, out, zt = borrowed((tab, mp, pr, rt, cs, tg, quad, out, zt))
     T_out = out.T
     U_out = out.U
     tau0 = out.tau0
@@ -295,109 +331,98 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales):
     eta = cs.eta
     us = cs.us
     sE, sR, seta, sus = _case_strides(cs)
-    dvs = tg.dvs
     times = tg.times
-    lnT = rt.lnT
+    src = zt.src
     x_lo, x_hi = mp.x_min, min(mp.x_max, x_fast)
-    nT, nU, nr = T_out.shape[0], U_out.shape[0], tg.ratios.size
+    nT, nU = T_out.shape[0], U_out.shape[0]
     per_case_times = times.shape[1] > 1
-    r1s = np.empty(1 + nr)  # ū/ū∞ - 1 of t_star and the ratios, and its log
-    r1s[0] = 0.01
-    r1s[1:] = tg.ratios - 1.0
-    zr = np.log(r1s)
-    src = same_targets(r1s, dvs)
-    zt = ZTargets(r1s, zr, dvs, lnT, src)
-    n = p0.size
     T_ext = tail_top(pr)
-    for blk in prange((n + BLOCK - 1) // BLOCK):
-        b0 = blk * BLOCK
-        b1 = min(b0 + BLOCK, n)
-        scr = np.empty((b1 - b0, _NSCR))
-        for i in range(b0, b1):  # stage 1: τ0, the stencil and v∞; rows not served
-            c = i - b0
-            Ri = R[i * sR]
-            tau = 3.0 * eta[i * seta] * Ri * Ri / (2.0 * h * h * p0[i])
-            x0 = math.log(p0[i] / E[i * sE])
-            vs_in = us[i * sus] / h
-            if timescales:
-                tau0[i] = tau
-            scr[c, _LIVE] = 0.0
-            if not (x_lo <= x0 <= x_hi):
-                _slow_row(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
-                continue
-            st = stencil(pr, x0)
-            vinf = math.exp(row_value(pr.lnv, st))
-            if not (vs_in != vs_in or vs_in * h > vinf * h):  # as reported (SI)
-                _below_row(vinf, vs_in, h, x0, i, out)
-                continue
-            scr[c, _LIVE] = 1.0
-            scr[c, _J0] = st[0]
-            scr[c, _W] = st[1]
-            scr[c, _W + 1] = st[2]
-            scr[c, _W + 2] = st[3]
-            scr[c, _W + 3] = st[4]
-            scr[c, _VINF] = vinf
-            scr[c, _TAU] = tau
-        for i in range(b0, b1):  # stage 2: the start
+    scr = np.empty((b1 - b0, _NSCR))
+    for i in range(b0, b1):  # stage 1: τ0, the stencil and v∞; rows not served
+        c = i - b0
+        Ri = R[i * sR]
+        tau = 3.0 * eta[i * seta] * Ri * Ri / (2.0 * h * h * p0[i])
+        x0 = math.log(p0[i] / E[i * sE])
+        vs_in = us[i * sus] / h
+        if timescales:
+            tau0[i] = tau
+        scr[c, _LIVE] = 0.0
+        if not (x_lo <= x0 <= x_hi):
+            _slow_row(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
+            continue
+        st = stencil(pr, x0)
+        vinf = math.exp(row_value(pr.lnv, st))
+        if not (vs_in != vs_in or vs_in * h > vinf * h):  # as reported (SI)
+            _below_row(vinf, vs_in, h, x0, i, out)
+            continue
+        scr[c, _LIVE] = 1.0
+        scr[c, _J0] = st[0]
+        scr[c, _W] = st[1]
+        scr[c, _W + 1] = st[2]
+        scr[c, _W + 2] = st[3]
+        scr[c, _W + 3] = st[4]
+        scr[c, _VINF] = vinf
+        scr[c, _TAU] = tau
+    for i in range(b0, b1):  # stage 2: the start
+        c = i - b0
+        if scr[c, _LIVE] == 0.0:
+            continue
+        st = _st_of(scr, c)
+        vinf = scr[c, _VINF]
+        tau = scr[c, _TAU]
+        zs, vs, Ts, Ts_row = _case_start(pr, st, vinf, us[i * sus] / h, rt)
+        scr[c, _ZS] = zs
+        scr[c, _VS] = vs
+        scr[c, _TS] = Ts
+        scr[c, _TSR] = Ts_row
+        scr[c, _BAD] = 0.0 if 0.0 < tau < math.inf else 1.0
+        u_inf[i] = vinf * h
+        u_start[i] = vs * h
+        if timescales:
+            t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
+            t_trap[i] = math.inf
+        u_trap[i] = math.nan
+        flf[i] = 0.0
+    for k in range(nT):  # stage 3: the time targets
+        ks = src[k]
+        for i in range(b0, b1):
             c = i - b0
             if scr[c, _LIVE] == 0.0:
                 continue
-            st = _st_of(scr, c)
-            vinf = scr[c, _VINF]
-            tau = scr[c, _TAU]
-            zs, vs, Ts, Ts_row = _case_start(pr, st, vinf, us[i * sus] / h, rt)
-            scr[c, _ZS] = zs
-            scr[c, _VS] = vs
+            if ks >= 0:  # the same target as an earlier one
+                T_out[k, i] = T_out[ks, i]
+                continue
+            tk, Ts = _target_time(pr, _st_of(scr, c), scr[c, _VINF], scr[c, _VS],
+                                  scr[c, _ZS], scr[c, _TS], scr[c, _TSR], scr[c, _TAU], k,
+                                  zt)
             scr[c, _TS] = Ts
-            scr[c, _TSR] = Ts_row
-            scr[c, _BAD] = 0.0 if 0.0 < tau < math.inf else 1.0
-            u_inf[i] = vinf * h
-            u_start[i] = vs * h
-            if timescales:
-                t_relax[i] = tau * math.exp(row_value(pr.lnS, st))
-                t_trap[i] = math.inf
-            u_trap[i] = math.nan
-            flf[i] = 0.0
-        for k in range(nT):  # stage 3: the time targets
-            ks = src[k]
-            for i in range(b0, b1):
-                c = i - b0
-                if scr[c, _LIVE] == 0.0:
-                    continue
-                if ks >= 0:  # the same target as an earlier one
-                    T_out[k, i] = T_out[ks, i]
-                    continue
-                tk, Ts = _target_time(pr, _st_of(scr, c), scr[c, _VINF], scr[c, _VS],
-                                      scr[c, _ZS], scr[c, _TS], scr[c, _TSR], scr[c, _TAU], k,
-                                      zt)
-                scr[c, _TS] = Ts
-                T_out[k, i] = tk
-                if tk == math.inf:
-                    scr[c, _BAD] = 1.0
-        if nU > 0:  # stage 4: ū at the times
-            for i in range(b0, b1):
-                c = i - b0
-                if scr[c, _LIVE] == 0.0:
-                    continue
-                ic = inverse_constants_ext(pr, _st_of(scr, c), T_ext)
-                for q in range(5):
-                    scr[c, _IC + q] = ic[q]
-            for k in range(nU):
-                for i in range(b0, b1):
-                    c = i - b0
-                    if scr[c, _LIVE] == 0.0:
-                        continue
-                    tt = times[k, i if per_case_times else i - i] / scr[c, _TAU]
-                    ic = (scr[c, _IC], scr[c, _IC + 1], scr[c, _IC + 2], scr[c, _IC + 3],
-                          scr[c, _IC + 4])
-                    u, Ts = _u_at(pr, _st_of(scr, c), scr[c, _VINF], scr[c, _VS], scr[c, _ZS],
-                                  scr[c, _TS], scr[c, _TSR], tt, h, ic)
-                    U_out[k, i] = u
-                    scr[c, _TS] = Ts
-        for i in range(b0, b1):  # stage 5: status
+            T_out[k, i] = tk
+            if tk == math.inf:
+                scr[c, _BAD] = 1.0
+    if nU > 0:  # stage 4: ū at the times
+        for i in range(b0, b1):
             c = i - b0
-            if scr[c, _LIVE] != 0.0:
-                status[i] = qk.ST_OVERFLOW if scr[c, _BAD] != 0.0 else qk.ST_OK
+            if scr[c, _LIVE] == 0.0:
+                continue
+            ic = inverse_constants_ext(pr, _st_of(scr, c), T_ext)
+            for q in range(5):
+                scr[c, _IC + q] = ic[q]
+        for k in range(nU):
+            for i in range(b0, b1):
+                c = i - b0
+                if scr[c, _LIVE] == 0.0:
+                    continue
+                tt = times[k, i if per_case_times else i - i] / scr[c, _TAU]
+                ic = (scr[c, _IC], scr[c, _IC + 1], scr[c, _IC + 2], scr[c, _IC + 3],
+                      scr[c, _IC + 4])
+                u, Ts = _u_at(pr, _st_of(scr, c), scr[c, _VINF], scr[c, _VS], scr[c, _ZS],
+                              scr[c, _TS], scr[c, _TSR], tt, h, ic)
+                U_out[k, i] = u
+                scr[c, _TS] = Ts
+    for i in range(b0, b1):  # stage 5: status
+        c = i - b0
+        if scr[c, _LIVE] != 0.0:
+            status[i] = qk.ST_OVERFLOW if scr[c, _BAD] != 0.0 else qk.ST_OK
 
 
 @njit(cache=True)
@@ -444,11 +469,21 @@ def one_case_primitive(pr, x0):
 
 @njit(parallel=True, cache=True)
 def history_kernel(pr, st, vs_in, tau, h, t, u):
-    """ū [m] of one case at the times t [s]; ``pr, st`` from :func:`one_case_primitive`."""
+    """ū [m] of one case at the times t [s]; ``pr, st`` from :func:`one_case_primitive`
+    (blocks of :data:`BLOCK` times in parallel, each one call of :func:`_history_block`)."""
+    n = t.size
+    for b in prange((n + BLOCK - 1) // BLOCK):
+        _history_block(pr, st, vs_in, tau, h, t, u, b * BLOCK, min(b * BLOCK + BLOCK, n))
+
+
+@njit(cache=True)
+def _history_block(pr, st, vs_in, tau, h, t, u, k0, k1):
+    """Times k0 <= k < k1 of :func:`history_kernel` (the primitive borrowed)."""
+    pr = borrowed(pr)
     vinf = math.exp(row_value(pr.lnv, st))
     vs, Ts = _start(pr, st, vinf, vs_in)
     ic = inverse_constants(pr, st)  # the same for every time of the case
-    for k in prange(t.size):
+    for k in range(k0, k1):
         tk = t[k] / tau
         if tk == 0.0:
             u[k] = vs * h

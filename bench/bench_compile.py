@@ -1,0 +1,138 @@
+"""First call of each squeeze-out path on a new machine (kernel compiling) and its speed after.
+
+For each path — squeeze_out with the default start, squeeze_out with per-case starts and three
+times, tire_footprint with every column, squeeze_history, and the Barus squeeze-out and tire
+(``alpha_pv``) — runs one fresh process with an empty numba cache per checkout (this one and
+``--baseline PATH``, e.g. a ``git worktree`` of the commit before) and times the path's first
+call (1,000 cases: what a user waits for the first time on a new machine), then the per-case
+CPU time of the same path with the cache warm, alternating the checkouts in fresh processes.
+Writes bench/compile_results.md.
+
+    python bench/bench_compile.py --baseline /tmp/wt_old
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+PATHS = {
+    "squeeze": "squeeze_out, default start",
+    "times": "squeeze_out, per-case start, 3 times",
+    "tire": "tire_footprint, every column",
+    "history": "squeeze_history (points)",
+    "barus": "squeeze_out, alpha_pv (Barus)",
+    "barus_tire": "tire_footprint, alpha_pv (Barus)",
+}
+
+JOB = r"""
+import json, math, sys, time
+t_start = time.perf_counter()
+import numpy as np
+from fastcontact.tables import Tables
+from fastcontact.tables.defaults import default_table_path
+from fastcontact.squeeze import squeeze_out, squeeze_history
+from fastcontact.tire import tire_footprint
+what, mode, n = sys.argv[1], sys.argv[2], int(float(sys.argv[3]))
+T = Tables.from_parquet(default_table_path("asphalt_024mm"))
+E, ETA, TH = 13e6, 1e-3, "emt"
+rng = np.random.default_rng(1)
+p0 = np.exp(rng.uniform(math.log(5e4), math.log(4e5), n))
+R = rng.uniform(0.005, 0.02, n)
+fl, sp = rng.uniform(0.05, 0.2, n), rng.uniform(5.0, 40.0, n)
+kw = dict(E_star=E, R=R, eta=ETA, theory=TH)
+if what == "squeeze":
+    job = lambda: squeeze_out(T, p0=p0, **kw)
+elif what == "times":
+    us = rng.uniform(1e-5, 1e-4, n)
+    job = lambda: squeeze_out(T, p0=p0, u_start=us, times=[1e-4, 1e-3, 1e-2], **kw)
+elif what == "tire":
+    job = lambda: tire_footprint(T, p0=p0, footprint_length=fl, speed=sp, **kw)
+elif what == "history":
+    t = np.geomspace(1e-6, 10.0, n)
+    job = lambda: squeeze_history(T, 2e5, E, 0.01, ETA, theory=TH, t=t)
+elif what == "barus":
+    job = lambda: squeeze_out(T, p0=p0, alpha_pv=1e-6, **kw)
+else:
+    job = lambda: tire_footprint(T, p0=p0, footprint_length=fl, speed=sp, alpha_pv=1e-6, **kw)
+t_ready = time.perf_counter()
+if mode == "first":
+    job()
+    print(json.dumps({"first_s": time.perf_counter() - t_ready,
+                      "import_s": t_ready - t_start}))
+    sys.exit()
+job()
+cpu = []
+for _ in range(5):
+    c = time.process_time(); job(); cpu.append(time.process_time() - c)
+print(json.dumps({"cpu_ns": float(np.median(cpu)) / n * 1e9}))
+"""
+
+
+def run(src, cache, *args):
+    env = dict(os.environ, PYTHONPATH=str(src), NUMBA_CACHE_DIR=str(cache))
+    # cwd outside both checkouts: ``python -c`` puts the cwd first on sys.path
+    out = subprocess.run([sys.executable, "-c", JOB, *args], env=env, check=True, cwd=cache.parent,
+                         capture_output=True, text=True).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--baseline", required=True, help="checkout of the commit before")
+    ap.add_argument("--pairs", type=int, default=3)
+    ap.add_argument("--n", type=float, default=3e5)
+    ap.add_argument("--paths", nargs="+", default=list(PATHS), choices=list(PATHS))
+    a = ap.parse_args()
+    here, base = HERE.parent, Path(a.baseline).resolve()
+    tmp = Path(tempfile.mkdtemp(prefix="fc_bench_compile_"))
+    t0 = time.time()
+    first = {}
+    for w in a.paths:
+        for k, s in (("old", base), ("new", here)):
+            cache = tmp / f"fresh_{k}_{w}"
+            first[(s, w)] = run(s, cache, w, "first", "1000")["first_s"]
+            shutil.rmtree(cache, ignore_errors=True)
+            print(k, w, f"{first[(s, w)]:.1f} s", flush=True)
+    caches = {here: tmp / "warm_new", base: tmp / "warm_old"}
+    for s in (here, base):
+        for w in a.paths:
+            run(s, caches[s], w, "first", "1000")
+    res = {(s, w): [] for s in (here, base) for w in a.paths}
+    for _ in range(a.pairs):
+        for s in (base, here):
+            for w in a.paths:
+                res[(s, w)].append(run(s, caches[s], w, "speed", str(a.n))["cpu_ns"])
+    load = os.getloadavg()
+    lines = ["## Kernel compiling: the first call of each path on a new machine", "",
+             f"Machine: {os.cpu_count()} cores, Python {sys.version.split()[0]}; load average "
+             f"{load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f} at the end, {time.time() - t0:.0f} s "
+             "in all. `bench/bench_compile.py`: this checkout against the commit before "
+             "(baseline). First call: a fresh process with an empty numba cache per path and "
+             "checkout, 1,000 cases (embedded asphalt_024mm, EMT), the kernels it compiles "
+             "included (imports and table loading not). Speed: the same path with the cache warm, "
+             f"alternating fresh processes, {a.pairs} pairs, median of 5 calls each, {a.n:.0e} "
+             "cases (points for the history), CPU time per case (both threads).", "",
+             "| path | first call before [s] | after [s] | ratio | CPU before [ns/case] | "
+             "after [ns/case] | ratio |", "|---|---|---|---|---|---|---|"]
+    for w in a.paths:
+        fb, fh = first[(base, w)], first[(here, w)]
+        b, h = statistics.median(res[(base, w)]), statistics.median(res[(here, w)])
+        lines.append(f"| {PATHS[w]} | {fb:.1f} | {fh:.1f} | {fh / fb:.2f} | {b:.0f} | {h:.0f} "
+                     f"| {h / b:.2f} |")
+    (HERE / "compile_results.md").write_text("\n".join(lines) + "\n")
+    shutil.rmtree(tmp, ignore_errors=True)
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
