@@ -4,7 +4,8 @@ For each path — squeeze_out with the default start, squeeze_out with per-case 
 times, tire_footprint with every column, squeeze_history, and the Barus squeeze-out and tire
 (``alpha_pv``) — runs one fresh process with an empty numba cache per checkout (this one and
 ``--baseline PATH``, e.g. a ``git worktree`` of the commit before) and times the path's first
-call (1,000 cases: what a user waits for the first time on a new machine), then the per-case
+call (1,000 cases, ``method="fast"``: what a user waits for the first time on a new machine;
+tire_footprint picks the per-case quadrature below 2,000 cases unless told), then the per-case
 CPU time of the same path with the cache warm, alternating the checkouts in fresh processes.
 Writes bench/compile_results.md.
 
@@ -56,14 +57,15 @@ elif what == "times":
     us = rng.uniform(1e-5, 1e-4, n)
     job = lambda: squeeze_out(T, p0=p0, u_start=us, times=[1e-4, 1e-3, 1e-2], **kw)
 elif what == "tire":
-    job = lambda: tire_footprint(T, p0=p0, footprint_length=fl, speed=sp, **kw)
+    job = lambda: tire_footprint(T, p0=p0, footprint_length=fl, speed=sp, method="fast", **kw)
 elif what == "history":
     t = np.geomspace(1e-6, 10.0, n)
     job = lambda: squeeze_history(T, 2e5, E, 0.01, ETA, theory=TH, t=t)
 elif what == "barus":
     job = lambda: squeeze_out(T, p0=p0, alpha_pv=1e-6, **kw)
 else:
-    job = lambda: tire_footprint(T, p0=p0, footprint_length=fl, speed=sp, alpha_pv=1e-6, **kw)
+    job = lambda: tire_footprint(T, p0=p0, footprint_length=fl, speed=sp, alpha_pv=1e-6,
+                                 method="fast", **kw)
 t_ready = time.perf_counter()
 if mode == "first":
     job()
@@ -118,7 +120,8 @@ def main():
              f"{load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f} at the end, {time.time() - t0:.0f} s "
              "in all. `bench/bench_compile.py`: this checkout against the commit before "
              "(baseline). First call: a fresh process with an empty numba cache per path and "
-             "checkout, 1,000 cases (embedded asphalt_024mm, EMT), the kernels it compiles "
+             "checkout, 1,000 cases (embedded asphalt_024mm, EMT, method \"fast\"), the kernels it "
+             "compiles "
              "included (imports and table loading not). Speed: the same path with the cache warm, "
              f"alternating fresh processes, {a.pairs} pairs, median of 5 calls each, {a.n:.0e} "
              "cases (points for the history), CPU time per case (both threads).", "",

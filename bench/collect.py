@@ -12,7 +12,7 @@ from pathlib import Path
 
 HERE = Path(__file__).parent
 ORDER = ["tables", "squeeze", "alloc", "seal", "sweep", "run_memory", "fuzz", "extensions",
-         "calibration_integration", "layout", "kernel_inputs"]
+         "calibration_integration", "layout", "kernel_inputs", "compile"]
 #: fragments whose script name differs from bench_<name>.py
 SCRIPT = {"run_memory": "bench_run_memory.py",
           "layout": "bench_tables.py --speed, bench_squeeze.py, bench_seal.py"}

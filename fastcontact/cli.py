@@ -12,6 +12,7 @@ Commands
 ``fastcontact roaddb generate PATH --n N --seed S``  synthetic road database
 ``fastcontact roaddb info PATH``               summary of a road database
 ``fastcontact figures -o OUTDIR``              regenerate every paper figure
+``fastcontact compile [GROUP ...] [--scene S] [-j N]``  compile the kernels ahead of a study
 
 Bad input (invalid scene, missing file, wrong option) exits with code 2 and a one-line
 message on stderr, no traceback.
@@ -297,6 +298,29 @@ def _cmd_figures(a, out, err):
     return 0
 
 
+def _cmd_compile(a, out, err):
+    from .warm import GROUPS, numba_cache_dir, scene_groups, warm
+    bad = [g for g in a.groups if g not in GROUPS]
+    if bad:
+        raise CLIError(f"fastcontact compile: group {bad[0]!r} is invalid: must be one of "
+                       f"{', '.join(GROUPS)}")
+    groups = list(a.groups)
+    if a.scene:
+        from .studies.load import load_scene
+        groups += scene_groups(load_scene(a.scene))
+    groups = list(dict.fromkeys(groups)) or list(GROUPS)
+    print(f"compiling {', '.join(groups)} ({a.jobs} at a time; kernels already in the cache "
+          "load in milliseconds) ...", file=err)
+    try:
+        secs = warm(groups, jobs=a.jobs, log=lambda m: print(m, file=err))
+    except RuntimeError as exc:  # a group's process failed: its last error line
+        print(f"fastcontact compile: error: {exc}", file=err)
+        return 1
+    print("compiled: " + ", ".join(f"{g} {s:.1f} s" for g, s in secs.items())
+          + f"; numba cache: {numba_cache_dir()}", file=out)
+    return 0
+
+
 def _cmd_roaddb_generate(a, out, err):
     from .surface.roaddb import generate_road_database, N_Q
     p = generate_road_database(a.path, a.n, a.seed, n_q=a.n_q or N_Q, convention=a.convention)
@@ -327,7 +351,7 @@ def _dispatch(a):
     if a.command == "bem":
         return getattr(a, "bem_func", None)
     return {"run": _cmd_run, "validate": _cmd_validate, "scenes": _cmd_scenes,
-            "sweep": _cmd_sweep, "figures": _cmd_figures}[a.command]
+            "sweep": _cmd_sweep, "figures": _cmd_figures, "compile": _cmd_compile}[a.command]
 
 
 #: first-generation threshold of Python's cycle collector while a command runs: its lazy
@@ -337,7 +361,8 @@ def _dispatch(a):
 GC_THRESHOLD = 100_000
 #: commands that, run from the command line, end the process as soon as they are done
 #: (:func:`_leave`); not ``sweep`` and ``bem`` (Dask clusters and workers shut down normally)
-_LEAVE_AT_ONCE = frozenset({"run", "validate", "scenes", "tables", "figures", "roaddb"})
+_LEAVE_AT_ONCE = frozenset({"run", "validate", "scenes", "tables", "figures", "roaddb",
+                            "compile"})
 
 
 def _leave(code):

@@ -140,6 +140,16 @@ def build_parser():
     w.add_argument("--cache-dir", help="keep/reuse the tables there (default: not kept)")
     w.add_argument("--no-progress", action="store_true", help="no progress line")
 
+    c = sub.add_parser("compile", help="compile the engines' kernels ahead of a study "
+                       "(numba's disk cache; tens of seconds per group on a new machine)")
+    c.add_argument("groups", nargs="*", metavar="GROUP",
+                   help="tables, squeeze, tire, seal, viscosity (default: every group, or "
+                        "those of --scene)")
+    c.add_argument("--scene", help="compile the groups this scene needs (file or shipped "
+                   "example name)")
+    c.add_argument("-j", "--jobs", type=_count, default=1,
+                   help="groups compiled at once, each in its own process")
+
     f = sub.add_parser("figures", help="regenerate every paper figure the engine makes")
     f.add_argument("-o", "--outdir", required=True, help="output folder for the PNG files")
 
