@@ -1,13 +1,13 @@
-"""First call of each squeeze-out path on a new machine (kernel compiling) and its speed after.
+"""First call of each engine path on a new machine (kernel compiling) and its speed after.
 
 For each path — squeeze_out with the default start, squeeze_out with per-case starts and three
-times, tire_footprint with every column, squeeze_history, and the Barus squeeze-out and tire
-(``alpha_pv``) — runs one fresh process with an empty numba cache per checkout (this one and
-``--baseline PATH``, e.g. a ``git worktree`` of the commit before) and times the path's first
-call (1,000 cases, ``method="fast"``: what a user waits for the first time on a new machine;
-tire_footprint picks the per-case quadrature below 2,000 cases unless told), then the per-case
-CPU time of the same path with the cache warm, alternating the checkouts in fresh processes.
-Writes bench/compile_results.md.
+times, tire_footprint with every column, squeeze_history, the Barus squeeze-out and tire
+(``alpha_pv``), and seal_leak's flat ring and Hertz O-ring — runs one fresh process with an
+empty numba cache per checkout (this one and ``--baseline PATH``, e.g. a ``git worktree`` of the
+commit before) and times the path's first call (1,000 cases, ``method="fast"``: what a user
+waits for the first time on a new machine; tire_footprint picks the per-case quadrature below
+2,000 cases unless told), then the per-case CPU time of the same path with the cache warm,
+alternating the checkouts in fresh processes. Writes bench/compile_results.md.
 
     python bench/bench_compile.py --baseline /tmp/wt_old
 """
@@ -33,6 +33,8 @@ PATHS = {
     "history": "squeeze_history (points)",
     "barus": "squeeze_out, alpha_pv (Barus)",
     "barus_tire": "tire_footprint, alpha_pv (Barus)",
+    "ring": "seal_leak, flat ring (rows)",
+    "oring": "seal_leak, Hertz O-ring (rows)",
 }
 
 JOB = r"""
@@ -43,6 +45,7 @@ from fastcontact.tables import Tables
 from fastcontact.tables.defaults import default_table_path
 from fastcontact.squeeze import squeeze_out, squeeze_history
 from fastcontact.tire import tire_footprint
+from fastcontact.seal import seal_leak
 what, mode, n = sys.argv[1], sys.argv[2], int(float(sys.argv[3]))
 T = Tables.from_parquet(default_table_path("asphalt_024mm"))
 E, ETA, TH = 13e6, 1e-3, "emt"
@@ -63,9 +66,16 @@ elif what == "history":
     job = lambda: squeeze_history(T, 2e5, E, 0.01, ETA, theory=TH, t=t)
 elif what == "barus":
     job = lambda: squeeze_out(T, p0=p0, alpha_pv=1e-6, **kw)
-else:
+elif what == "barus_tire":
     job = lambda: tire_footprint(T, p0=p0, footprint_length=fl, speed=sp, alpha_pv=1e-6,
                                  method="fast", **kw)
+elif what == "ring":
+    job = lambda: seal_leak(T, p0=p0, dp=0.5 * p0, L=1e-3, L_y=0.1, E_star=E, eta=ETA,
+                            theory="critical_junction", alpha_cj=0.54)
+else:
+    fN = rng.uniform(20.0, 200.0, min(n, 2000))  # the O-ring solves rows: fewer of them
+    job = lambda: seal_leak(T, profile="hertz", R=2e-3, f_N=fN, dp=1e4, L_y=0.1, E_star=E,
+                            eta=ETA, theory="critical_junction")
 t_ready = time.perf_counter()
 if mode == "first":
     job()
@@ -124,7 +134,7 @@ def main():
              "compiles "
              "included (imports and table loading not). Speed: the same path with the cache warm, "
              f"alternating fresh processes, {a.pairs} pairs, median of 5 calls each, {a.n:.0e} "
-             "cases (points for the history), CPU time per case (both threads).", "",
+             "cases (points for the history; 2,000 O-rings), CPU time per case (both threads).", "",
              "| path | first call before [s] | after [s] | ratio | CPU before [ns/case] | "
              "after [ns/case] | ratio |", "|---|---|---|---|---|---|---|"]
     for w in a.paths:

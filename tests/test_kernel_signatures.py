@@ -72,10 +72,26 @@ def _differences(signatures):
     return {k: [f.get(k) for f in flats] for k in keys if len({f.get(k) for f in flats}) > 1}
 
 
+def _helpers():
+    """Helpers the kernels call that were compiled twice before 2026-11-28: once per literal
+    int argument (numba specialises a callee on ``f(0, ...)`` and ``f(1, ...)``) or once for a
+    prange index (uint64) and once for a block loop's (int64). A helper reached through a
+    kernel loaded from the disk cache is not compiled (no signature); where this process
+    compiles it (an empty numba cache, as in CI) it must compile once."""
+    from fastcontact.seal import _leak, _panels
+    from fastcontact.squeeze import _fastpath, _kernels, _primitive_build, tire_piezo, viscosity
+
+    return [_fastpath._slow_row, _kernels.quad_case, viscosity._piezo_case,
+            viscosity._no_times, tire_piezo._tire_case, _primitive_build._build_row,
+            _panels.solve_case, _panels.solve_robust, _panels.solve_row, _leak._gl_fast]
+
+
 def _one_signature(*reached):
-    """``reached`` compiled (or loaded) exactly once; no parallel kernel more than once."""
+    """``reached`` compiled (or loaded) exactly once; no parallel kernel, and none of the
+    :func:`_helpers`, more than once."""
     many = {f"{k.__module__}.{k.py_func.__qualname__}": _differences(k.signatures)
-            for k in set(_parallel_kernels()) | set(reached) if len(k.signatures) > 1}
+            for k in set(_parallel_kernels()) | set(_helpers()) | set(reached)
+            if len(k.signatures) > 1}
     assert not many, many
     missed = [k.py_func.__qualname__ for k in reached if len(k.signatures) != 1]
     assert not missed, f"not reached by the calls: {missed}"

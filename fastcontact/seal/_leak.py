@@ -25,6 +25,10 @@ from ._lookup import _sig_fast
 from ._primitive import (P_OK, P_T, _adaptive, _asym, _gl_s, _left, _right, _split, _whole,
                          asym_primitive)
 
+#: the order 0 ("the rule in G") as an argument of a jitted helper: a literal int would compile
+#: the helper once per value (numba specialises on literal ints); a NumPy int64 is typed int64
+_I0 = np.int64(0)
+
 __all__ = ["leak_integral", "uniform_rows", "RingRows", "RingOut", "invert_uniform", "ST_OK",
            "ST_LIFT_OFF", "ST_OPEN", "ST_PERCOLATED", "ST_ABOVE_TABLE", "ST_NOT_CONVERGED",
            "ST_NEAR_PERCOLATION", "TAIL_RTOL", "SHORT_RTOL"]
@@ -119,8 +123,8 @@ def _fast_integral(P, B, R, TQ, TQB, HS, G, hi, w):
         if ka < 0 <= kb:                      # split at the C¹ join with the asymptote
             e0 = math.exp(st0)
             wt = min(hi - e0, w)
-            return (_gl_fast(R, TQ, TQB, HS, G, e0, w - wt, 0)
-                    + _gl_fast(R, TQ, TQB, HS, G, hi, wt, 0))
+            return (_gl_fast(R, TQ, TQB, HS, G, e0, w - wt, _I0)
+                    + _gl_fast(R, TQ, TQB, HS, G, hi, wt, _I0))
         return _gl_fast(R, TQ, TQB, HS, G, hi, w, _gl_order(R, HS, tb, tb - ta))
     t_lo, b0, b1 = hs.t_lo, hs.b0, hs.b1
     if kb < 0:

@@ -52,6 +52,10 @@ __all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "solve_rows_
 
 #: status codes of solve_case
 ST_OK, ST_NOT_REFINED, ST_NEWTON_FAILED, ST_NO_ZONE = 0, 1, 2, 3
+#: the integers 0 and 1 as arguments of jitted helpers: numba compiles a helper once per
+#: literal int it is called with (``f(0, ...)`` and ``f(1, ...)`` are two compiles of several
+#: seconds each, a third for a variable); a NumPy integer is typed int64, as a variable is
+_I0, _I1 = np.int64(0), np.int64(1)
 
 
 @njit(cache=True, inline="always")
@@ -468,7 +472,7 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, al, vis, out
         return 0.0, ST_NO_ZONE, 0, 0.0, 0, 0
     nil = np.empty(0)
     W, st, P, est, its = solve_case(tab, sc, rule, rule.tol, rule.maxit,
-                                    Zone(kind, gp, xg, pg, pia, pib, al, vis), out, 0, nil, nil, nil)
+                                    Zone(kind, gp, xg, pg, pia, pib, al, vis), out, _I0, nil, nil, nil)
     if st != ST_NEWTON_FAILED:
         return W, st, P, est, its, 0
     cperc = sc.p_perc
@@ -483,8 +487,7 @@ def solve_robust(tab, sc, rule, kind, base, xg, pg, pmax, pia, pib, al, vis, out
     zone_params(kind, base, xg, pg, pa0, pib, gp)
     W, st, P, est, it0 = solve_case(tab, sc, rule, 1e-2, rule.maxit,
                                     Zone(kind, gp, xg, pg, pa0, pib, al, vis), Mesh(pan, cc, rr),
-                                    0,
-                                    pan, sn, sn)
+                                    _I0, pan, sn, sn)
     its += it0
     if st == ST_NEWTON_FAILED:
         return W, st, P, est, its, 0
@@ -548,14 +551,14 @@ def solve_row(tab, sc, rule, kind, xg, p0n, amp, pia, pib, al, vis, mesh):
     if kind == 0:
         base1 = np.empty(1)
         base1[0] = amp
-        W, st, P, est, its, cs = solve_robust(tab, sc, rule, 0, base1, xg, p0n, amp, pia, pib,
+        W, st, P, est, its, cs = solve_robust(tab, sc, rule, _I0, base1, xg, p0n, amp, pia, pib,
                                               al, vis, mesh)
         xs = math.nan
         xe = math.nan
     else:
         pg = p0n * amp
         xs, xe = array_zone(xg, pg, pia, pib)
-        W, st, P, est, its, cs = solve_robust(tab, sc, rule, 1, pg, xg, pg, pg.max(), pia, pib,
+        W, st, P, est, its, cs = solve_robust(tab, sc, rule, _I1, pg, xg, pg, pg.max(), pia, pib,
                                               al, vis, mesh)
     return W, st, P, est, xs, xe
 
@@ -615,13 +618,13 @@ def solve_rows_chained(tab, sc, rule, xg, p0n, amp, pia, pib, al, vis, rows, sta
             P = 0
             est = 0.0
             base1[0] = amp[i]
-            if P_prev > 0 and zone_params(0, base1, xg, p0n, pia[i], pib[i], gp):
+            if P_prev > 0 and zone_params(_I0, base1, xg, p0n, pia[i], pib[i], gp):
                 W, st, P, est, _its = solve_case(
                     tab, sc, rule, rule.tol, rule.maxit,
                     Zone(0, gp, xg, p0n, pia[i], pib[i], al[i], vis[i]), mesh, P_prev, pan_prev,
                     s_prev, nil)
             if st == ST_NEWTON_FAILED:
-                W, st, P, est, _xs, _xe = solve_row(tab, sc, rule, 0, xg, p0n, amp[i], pia[i],
+                W, st, P, est, _xs, _xe = solve_row(tab, sc, rule, _I0, xg, p0n, amp[i], pia[i],
                                                     pib[i], al[i], vis[i], mesh)
             _store_row(out, i, W, st, P, est, math.nan, math.nan)
             P_prev = 0

@@ -180,7 +180,7 @@ def _squeeze_block(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, q
         u_inf[i] = vinf * h
         u_start[i] = vs * h
         if not (vs * h > vinf * h):  # a given start at or below ū∞ (as reported, SI)
-            _no_times(out, i, ST_BELOW)
+            _no_times(out, i, np.int64(ST_BELOW))
             g_start[i] = math.nan
             continue
         g_start[i] = _rate_factor(A * ds) if A > 0.0 else 1.0

@@ -434,7 +434,8 @@ def _tau0(tau, i, out):
 def quad_kernel(tab, mp, cs, h, tg, quad, out):
     """method="quad": every case by per-case quadrature (one prange pass)."""
     sE, sR, seta, sus = _case_strides(cs)
-    for i in prange(cs.p0.size):
+    for j in prange(cs.p0.size):
+        i = np.int64(j)  # a prange index is uint64: the helpers' other callers pass int64
         Ri = cs.R[i * sR]
         tau = 3.0 * cs.eta[i * seta] * Ri * Ri / (2.0 * h * h * cs.p0[i])
         _slow_row(tab, mp, math.log(cs.p0[i] / cs.E[i * sE]), cs.us[i * sus] / h, tg, tau, h,

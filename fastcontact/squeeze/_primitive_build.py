@@ -211,7 +211,7 @@ def _build_kernel(pf, mp, pr, glx, glw):
         vinf = math.exp(lv)
         lnv[j] = lv
         lk[j] = _lnkappa(pf, mp, vinf)
-        _build_row(pf, mp, x0, vinf, lk[j], z0, dz, glx, glw, C, j)
+        _build_row(pf, mp, x0, vinf, lk[j], z0, dz, glx, glw, C, np.int64(j))  # one type
         e, lm, de, dl = _pstate(pf, mp, vinf)
         lnS[j] = lv - math.log(-de) - lm  # S = v∞ |d ln v/d ln π| / σ̄(π0): dT/d(-z) at ū∞
         vs = math.exp(_plnv(pf, mp, x0 + mp.lnp_start))

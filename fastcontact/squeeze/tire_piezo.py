@@ -98,8 +98,8 @@ def _tire_kernel(tab, sc, cs, alpha, t_fp, h, tg, quad, out):
     """Per case (``cs`` :class:`~fastcontact.squeeze._kernels.Cases`, α [1/Pa] and the
     footprint time t_fp [s] apart): targets (ratios × v∞, then v∞ + dv) and ū at t_fp (t_fp
     of size 0: none, u_exit NaN), SI, into ``out`` (:data:`TireOut`)."""
-    for i in prange(cs.p0.size):
-        _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out)
+    for i in prange(cs.p0.size):  # the index as int64, as the fast path's blocks pass it
+        _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, np.int64(i), out)
 
 
 def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_complete,

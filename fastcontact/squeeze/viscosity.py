@@ -311,14 +311,14 @@ def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
     x0, tau, inside = _case_head(cs, sc, h, i)
     out.tau0[i] = tau
     if not inside:
-        _no_times(out, i, ST_OUT)
+        _no_times(out, i, np.int64(ST_OUT))
         out.u_inf[i] = math.nan
         out.u_start[i] = cs.us[i]
         out.g_start[i] = math.nan
         return
     vinf, vs = _case_start(tab, sc, x0, cs, h, i, out)
     if not (vs * h > vinf * h):  # a given start at or below ū∞ (as reported, SI)
-        _no_times(out, i, ST_BELOW)
+        _no_times(out, i, np.int64(ST_BELOW))
         out.g_start[i] = math.nan
         return
     api = alpha[i] * cs.p0[i]
@@ -326,7 +326,7 @@ def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
     d_start = -math.expm1(lnps - x0)
     out.g_start[i] = _rate_factor(api * d_start) if api > 0.0 else 1.0
     if api * d_start >= 1.0:
-        _no_times(out, i, ST_PIEZO)
+        _no_times(out, i, np.int64(ST_PIEZO))
         return
     out.status[i] = ST_TRAPPED if x0 >= sc[0].x_trap else ST_OK
     _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, out.T, i)
@@ -344,8 +344,8 @@ def _piezo_kernel(tab, sc, cs, alpha, h, tg, quad, out):
     """Per case (``cs`` :class:`~fastcontact.squeeze._kernels.Cases`, α [1/Pa] apart): targets
     (ratios × v∞, then v∞ + dv) sorted downward, one pass (t̃ → SI) into ``out``
     (:data:`BarusOut`)."""
-    for i in prange(cs.p0.size):
-        _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out)
+    for i in prange(cs.p0.size):  # the index as int64, as the fast path's blocks pass it
+        _piezo_case(tab, sc, cs, alpha, h, tg, quad, np.int64(i), out)
 
 
 # =========================================================================== model
