@@ -24,6 +24,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from results_notes import write_keeping_notes
+
 HERE = Path(__file__).resolve().parent
 
 PATHS = {
@@ -142,7 +144,7 @@ def main():
         b, h = statistics.median(res[(base, w)]), statistics.median(res[(here, w)])
         lines.append(f"| {PATHS[w]} | {fb:.1f} | {fh:.1f} | {fh / fb:.2f} | {b:.0f} | {h:.0f} "
                      f"| {h / b:.2f} |")
-    (HERE / "compile_results.md").write_text("\n".join(lines) + "\n")
+    write_keeping_notes(HERE / "compile_results.md", "\n".join(lines) + "\n")
     shutil.rmtree(tmp, ignore_errors=True)
     print("\n".join(lines))
 
