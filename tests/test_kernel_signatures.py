@@ -127,5 +127,8 @@ def test_seal_kernels(flavours):
         for f_N in _inputs([2.0, 3.0]):
             fc.seal_leak(T, profile="hertz", R=1e-3, f_N=f_N, dp=1e4, L_y=L_Y, E_star=E,
                          eta=ETA)
-    _one_signature(_leak.uniform_rows, _panels.solve_rows,
+        # a Δp sweep of one O-ring with a Barus fluid: the chained solver
+        fc.seal_leak(T, profile="hertz", R=1e-3, f_N=2.0, dp=np.linspace(1e3, 4e4, 12),
+                     L_y=L_Y, E_star=E, eta=ETA, alpha_pv=1e-5)
+    _one_signature(_leak.uniform_rows, _panels.solve_rows, _panels.solve_rows_chained,
                    _piezo_kernels._uniform_sweep_kernel)

@@ -610,12 +610,12 @@ def solve_rows_chained(tab, sc, rule, xg, p0n, amp, pia, pib, al, vis, rows, sta
         gp = np.empty(3)
         base1 = np.empty(1)
         nil = np.empty(0)
-        P_prev = 0
+        P_prev = _I0  # int64 throughout: a literal 0 would reach solve_case as Literal[int](0)
         for j in range(starts[c], starts[c + 1]):
             i = rows[j]
             st = ST_NEWTON_FAILED
             W = 0.0
-            P = 0
+            P = _I0
             est = 0.0
             base1[0] = amp[i]
             if P_prev > 0 and zone_params(_I0, base1, xg, p0n, pia[i], pib[i], gp):
@@ -627,7 +627,7 @@ def solve_rows_chained(tab, sc, rule, xg, p0n, amp, pia, pib, al, vis, rows, sta
                 W, st, P, est, _xs, _xe = solve_row(tab, sc, rule, _I0, xg, p0n, amp[i], pia[i],
                                                     pib[i], al[i], vis[i], mesh)
             _store_row(out, i, W, st, P, est, math.nan, math.nan)
-            P_prev = 0
+            P_prev = _I0
             if st != ST_NEWTON_FAILED and st != ST_NO_ZONE and W > 0.0 and P > 0:
                 # the next row's start: this one's mesh and remaining fraction at its nodes
                 panel_series(mesh.r, mesh.pan, P, n, rule.Lp, coef, after)
