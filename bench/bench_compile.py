@@ -14,16 +14,15 @@ alternating the checkouts in fresh processes. Writes bench/compile_results.md.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
+from checkouts import run_job
 from results_notes import write_keeping_notes
 
 HERE = Path(__file__).resolve().parent
@@ -88,16 +87,13 @@ job()
 cpu = []
 for _ in range(5):
     c = time.process_time(); job(); cpu.append(time.process_time() - c)
-print(json.dumps({"cpu_ns": float(np.median(cpu)) / n * 1e9}))
+cases = fN.size if what == "oring" else n
+print(json.dumps({"cpu_ns": float(np.median(cpu)) / cases * 1e9}))
 """
 
 
 def run(src, cache, *args):
-    env = dict(os.environ, PYTHONPATH=str(src), NUMBA_CACHE_DIR=str(cache))
-    # cwd outside both checkouts: ``python -c`` puts the cwd first on sys.path
-    out = subprocess.run([sys.executable, "-c", JOB, *args], env=env, check=True, cwd=cache.parent,
-                         capture_output=True, text=True).stdout
-    return json.loads(out.strip().splitlines()[-1])
+    return run_job(JOB, src, cache, *args)
 
 
 def main():

@@ -13,13 +13,13 @@ signature). Writes bench/kernel_inputs_results.md.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from checkouts import run_job
 
 HERE = Path(__file__).resolve().parent
 
@@ -59,11 +59,7 @@ print(json.dumps({"cpu_ns": float(np.median(cpu)) / n * 1e9}))
 
 
 def run(src, cache, *args):
-    env = dict(os.environ, PYTHONPATH=str(src), NUMBA_CACHE_DIR=str(cache))
-    # cwd outside both checkouts: ``python -c`` puts the cwd first on sys.path
-    out = subprocess.run([sys.executable, "-c", JOB, *args], env=env, check=True, cwd=cache.parent,
-                         capture_output=True, text=True).stdout
-    return json.loads(out.strip().splitlines()[-1])
+    return run_job(JOB, src, cache, *args)
 
 
 def main():

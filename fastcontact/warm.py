@@ -23,6 +23,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import tempfile
 import time
 
 __all__ = ["GROUPS", "warm", "warm_group", "scene_groups", "numba_cache_dir"]
@@ -131,17 +132,21 @@ def warm(groups=None, jobs=1, log=None):
     while pending or running:
         while pending and len(running) < jobs:
             g = pending.pop(0)
-            cmd = [sys.executable, "-c", "import sys\nfrom fastcontact.warm import warm_group\n"
+            cmd = [sys.executable, "-c", f"from fastcontact.warm import warm_group\n"
                    f"warm_group({g!r})"]
-            running[g] = (time.perf_counter(), subprocess.Popen(
-                cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True))
-        for g, (t0, proc) in list(running.items()):
+            # stderr to a file, not a pipe: a pipe read only at the end blocks a chatty child
+            err = tempfile.TemporaryFile(mode="w+")
+            running[g] = (time.perf_counter(), err, subprocess.Popen(
+                cmd, env=env, stdout=subprocess.DEVNULL, stderr=err, text=True))
+        for g, (t0, err, proc) in list(running.items()):
             if proc.poll() is None:
                 continue
-            errtext = proc.stderr.read()
+            err.seek(0)
+            errtext = err.read()
+            err.close()
             del running[g]
             if proc.returncode != 0:
-                for _g, (_t, p) in running.items():
+                for _g, (_t, _e, p) in running.items():
                     p.kill()
                 last = errtext.strip().splitlines()[-1] if errtext.strip() else "no message"
                 raise RuntimeError(f"compiling group {g!r} failed (exit {proc.returncode}): "

@@ -1,5 +1,6 @@
 """``fastcontact compile`` (fastcontact.warm): kernels compiled ahead of a study are loaded, not
 compiled again, by a later process; groups inferred from scenes; bad input in one line."""
+import json
 import os
 import subprocess
 import sys
@@ -56,13 +57,12 @@ def test_compiled_group_loads_without_compiling(tmp_path):
     after = subprocess.run([sys.executable, "-c", _COUNT, "tables"], env=_env(cache),
                            cwd=tmp_path, capture_output=True, text=True, timeout=900)
     assert after.returncode == 0, after.stderr
-    counts = eval_json(after.stdout)
+    counts = _last_json(after.stdout)
     assert counts["probe"] == 1      # the listener sees a compile
     assert counts["fastcontact"] == 0
 
 
-def eval_json(text):
-    import json
+def _last_json(text):
     return json.loads(text.strip().splitlines()[-1])
 
 

@@ -471,19 +471,21 @@ def one_case_primitive(pr, x0):
 @njit(parallel=True, cache=True)
 def history_kernel(pr, st, vs_in, tau, h, t, u):
     """ū [m] of one case at the times t [s]; ``pr, st`` from :func:`one_case_primitive`
-    (blocks of :data:`BLOCK` times in parallel, each one call of :func:`_history_block`)."""
-    n = t.size
-    for b in prange((n + BLOCK - 1) // BLOCK):
-        _history_block(pr, st, vs_in, tau, h, t, u, b * BLOCK, min(b * BLOCK + BLOCK, n))
-
-
-@njit(cache=True)
-def _history_block(pr, st, vs_in, tau, h, t, u, k0, k1):
-    """Times k0 <= k < k1 of :func:`history_kernel` (the primitive borrowed)."""
-    pr = borrowed(pr)
+    (the case's start once, then blocks of :data:`BLOCK` times in parallel, each one call of
+    :func:`_history_block`)."""
     vinf = math.exp(row_value(pr.lnv, st))
     vs, Ts = _start(pr, st, vinf, vs_in)
     ic = inverse_constants(pr, st)  # the same for every time of the case
+    n = t.size
+    for b in prange((n + BLOCK - 1) // BLOCK):
+        _history_block(pr, st, vinf, vs, Ts, ic, tau, h, t, u, b * BLOCK,
+                       min(b * BLOCK + BLOCK, n))
+
+
+@njit(cache=True)
+def _history_block(pr, st, vinf, vs, Ts, ic, tau, h, t, u, k0, k1):
+    """Times k0 <= k < k1 of :func:`history_kernel` (the primitive borrowed)."""
+    pr = borrowed(pr)
     for k in range(k0, k1):
         tk = t[k] / tau
         if tk == 0.0:
