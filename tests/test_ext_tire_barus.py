@@ -117,30 +117,40 @@ def test_start_below_equilibrium_flagged_trapped_rows_too(tables):
         assert np.all(np.isnan(barus[c])) and np.all(np.isnan(base[c])), c
 
 
-@pytest.mark.parametrize("method", ["fast", "quad"])
-def test_columns_select_what_the_barus_kernel_computes(tables, method, monkeypatch):
+@pytest.mark.parametrize("engine", ["one fluid", "two fluids", "quad"])
+def test_columns_select_what_the_barus_kernel_computes(tables, engine, monkeypatch):
     """With α > 0 a study asking for some columns gets them equal to the full call's, and the
-    Barus kernel computes only the targets they need (its call is spied on: the ratio
-    targets after t_star's 1.01, the Δu targets and whether footprint times reach it); rows
-    with α = 0 in the same call (the base engine) follow the same selection."""
+    engine computes only the targets they need (its call is spied on: the ratio targets after
+    t_star, the Δu targets and whether footprint times reach it) — the base kernel on the
+    Barus time primitive where the call has one α and one E* ("one fluid"), the per-case
+    Barus kernel where it has two, the quadrature; rows with α = 0 in the same call (the base
+    engine) follow the same selection."""
     import fastcontact.squeeze._barus_fast as bf
+    import fastcontact.squeeze._barus_time as bt
     import fastcontact.squeeze.tire_piezo as tp
 
     rng = np.random.default_rng(5)
     n = 30
     alpha = np.where(rng.random(n) < 0.2, 0.0, ALPHA)
+    if engine == "two fluids":
+        alpha[rng.random(n) < 0.3] = 0.5 * ALPHA
+    method = "quad" if engine == "quad" else "fast"
     kw = dict(p0=rng.uniform(0.05e6, 0.2e6, n), E_star=E_STAR, R=R, eta=ETA,
               footprint_length=0.1, speed=rng.uniform(5, 40, n), theory="emt",
               u_start=20 * tables.h_rms, alpha_pv=alpha, method=method)
     full = tire_footprint(tables, **kw)
     calls = []
-    name = "tire_kernel" if method == "fast" else "_tire_kernel"
-    mod = bf if method == "fast" else tp
+    mod, name = {"one fluid": (bt, "tire_rows"), "two fluids": (bf, "tire_kernel"),
+                 "quad": (tp, "_tire_kernel")}[engine]
     real = getattr(mod, name)
 
     def spy(*args):
-        tg, t_fp = (args[10], args[8]) if method == "fast" else (args[6], args[4])
-        calls.append((tuple(tg.ratios[1:]), tg.dvs.size, t_fp.size > 0))
+        if engine == "one fluid":  # (model, bg, cases, t_fp, h, ratios, dvs, ...)
+            r, dvs, t_fp = tuple(args[5]), args[6].size, args[3]
+        else:
+            tg, t_fp = (args[10], args[8]) if method == "fast" else (args[6], args[4])
+            r, dvs = tuple(tg.ratios[1:]), tg.dvs.size
+        calls.append((r, dvs, t_fp.size > 0))
         return real(*args)
 
     monkeypatch.setattr(mod, name, spy)

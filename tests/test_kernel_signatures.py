@@ -107,12 +107,19 @@ def test_squeeze_and_tire_kernels(flavours):
                     fc.squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, u_start=u0,
                                    times=(1e-3,), method=method, theory="average")
             for method in ("fast", "quad"):
-                fc.squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, alpha_pv=1e-6,
-                               times=(1e-3,), method=method, theory="average")
+                for alpha in (1e-6, [1e-6, 2e-6]):  # one fluid (the base kernel on the
+                    # Barus time primitive where it serves) and two (the per-case kernel)
+                    fc.squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, alpha_pv=alpha,
+                                   times=(1e-3,), method=method, theory="average")
                 fc.tire_footprint(T, p0=p0, E_star=E, R=R, eta=ETA, footprint_length=0.1,
                                   speed=20.0, method=method, theory="average")
                 fc.tire_footprint(T, p0=p0, E_star=E, R=R, eta=ETA, footprint_length=0.1,
                                   speed=20.0, method=method, alpha_pv=1e-6, theory="average")
+                # two fluids in one call: the per-case Barus kernel (one fluid: the base kernel
+                # on the Barus time primitive — fast_kernel, held to one signature here)
+                fc.tire_footprint(T, p0=p0, E_star=E, R=R, eta=ETA, footprint_length=0.1,
+                                  speed=20.0, method=method, alpha_pv=[1e-6, 2e-6],
+                                  theory="average")
     _one_signature(_fastpath.fast_kernel, _fastpath.quad_kernel, _barus_fast.squeeze_kernel,
                    _barus_fast.tire_kernel, viscosity._piezo_kernel, tire_piezo._tire_kernel)
 

@@ -102,6 +102,39 @@ def _tire_kernel(tab, sc, cs, alpha, t_fp, h, tg, quad, out):
         _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, np.int64(i), out)
 
 
+def _fast_rows(tables, theory, tab, sc, cs, al, tf, h, tg, quad, res):
+    """method "fast": the rows the G primitive serves (one α and one E* for the call:
+    :mod:`._barus_time`, the base engine's kernel) and the others by the Barus kernel
+    (:func:`._barus_fast.tire_kernel`), into ``res``."""
+    from ._barus_fast import ratio_rows, tire_kernel
+    from ._barus_time import served_rows, tire_rows
+    from .model import squeeze_model
+    setup = fast_setup(tables, theory, None)
+    model = squeeze_model(tables, theory)
+    bg, gi, rest = served_rows(model, setup, cs.p0, cs.E, al, cs.us, h)
+    if gi.size:
+        tire_rows(model, bg, cs, tf, h, tg.ratios[1:], tg.dvs, quad, res, gi)
+    if rest.size == 0:
+        return
+    if gi.size:  # the others as a call of their own
+        def sub(a):
+            return readonly(np.ascontiguousarray(a[rest]))
+        cs_r = Cases(*(sub(a) for a in cs))
+        T_r = np.empty((res.T.shape[0], rest.size))
+        part = TireOut(T_r, *(np.empty(rest.size) for _ in range(5)),
+                       np.empty(rest.size, dtype=np.int8))
+        tire_kernel(tab, sc, *setup, cs_r, sub(al), sub(tf) if tf.size else tf, h, tg,
+                    *ratio_rows(*setup[:3], tg), quad, part, fast_scratch())
+        for name in TireOut._fields:
+            if name == "T":
+                res.T[:, rest] = part.T
+            else:
+                getattr(res, name)[rest] = getattr(part, name)
+        return
+    tire_kernel(tab, sc, *setup, cs, al, tf, h, tg, *ratio_rows(*setup[:3], tg), quad, res,
+                fast_scratch())
+
+
 def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_complete,
                        alpha, out, base_columns, method="fast", want=None):
     """Fill the squeeze-out columns of :func:`~fastcontact.squeeze.tire.tire_footprint` with
@@ -140,10 +173,7 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
         quad, res = Quad(x, w, QUAD_WIDTH), TireOut(T, ue, ui, us, ut, fl, st)
         tab, sc = tables.kernel_data(theory), _scalars(tables, theory, None)
         if method == "fast":
-            from ._barus_fast import ratio_rows, tire_kernel
-            setup = fast_setup(tables, theory, None)
-            tire_kernel(tab, sc, *setup, cs, al, tf, h, tg, *ratio_rows(*setup[:3], tg), quad,
-                        res, fast_scratch())
+            _fast_rows(tables, theory, tab, sc, cs, al, tf, h, tg, quad, res)
         else:
             _tire_kernel(tab, sc, cs, al, tf, h, tg, quad, res)
     piezo = {"u_inf": ui, "u_start": us, "t_star": T[0], "trapped": st == _TRAPPED,
@@ -155,6 +185,10 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
             piezo.update(u_exit=ue, du_exit=ue - ui, squeeze_complete=(ue - ui) <= du_complete)
     for j, k in enumerate(keep):
         piezo[ratio_names[k]] = T[1 + j]
+    if m == n:  # every row Barus: the kernel's arrays are the columns (no copy)
+        out.update(piezo)
+        out["status"] = pd.Categorical.from_codes(st, categories=list(STATUS))
+        return squeeze_model(tables, theory)
     codes = np.empty(n, dtype=np.int8)
     codes[sel] = st
     base = {}

@@ -418,9 +418,12 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
         Times [s] >= 0 (inf allowed) → columns ``u_at_<t>``: ū at that time [m] (ū(0) =
         u_start; ū∞, or ū_trap on a trapped row, as t → ∞).
     method : {"fast", "quad"}, default "fast"
-        "fast": every time is two interpolations of the constant-viscosity time primitive
-        plus the tabulated Barus correction (:mod:`._barus_primitive`, built once per
-        tables and theory in ~5-20 ms); rows it does not serve (α p0 > 0.6, p0 within 4.4 % of
+        "fast": a call of one α and one E* runs the base engine's kernel on the Barus time
+        primitive G = T + α p0 S built for them (:mod:`._barus_time`, ~5-40 ms, kept), at
+        the base engine's speed; with α or E* per case every time is two interpolations of
+        the constant-viscosity time primitive plus the tabulated Barus correction
+        (:mod:`._barus_primitive`, built once per tables and theory in ~5-20 ms); rows
+        neither serves (α p0 > 0.6, p0 within 4.4 % of
         the trap pressure or beyond, outside the tables) take the per-case quadrature in the
         same pass. "quad": the per-case quadrature for every row.
     quad_order, quad_width :
@@ -477,18 +480,57 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     al = readonly(flat[4])
     tg = readonly_fields(BarusTargets(vr, dv, times))
     quad, out = Quad(x, w, width), BarusOut(T, U, uinf, ustart, tau0, gs, status)
+    served = None
     if method == "fast":
-        from ._barus_fast import ratio_rows, squeeze_kernel
-        setup = fast_setup(tables, theory, sigma_trap)
-        squeeze_kernel(tables.kernel_data(theory), sc, *setup, cs, al, h, tg,
-                       *ratio_rows(*setup[:3], tg), quad, out, fast_scratch())
+        served = _fast_rows(tables, theory, sigma_trap, sc, cs, al, h, tg, quad, out)
     else:
         _piezo_kernel(tables.kernel_data(theory), sc, cs, al, h, tg, quad, out)
     df = _piezo_frame(flat, ratios, du, times, T, U, uinf, ustart, tau0, gs, status, theory,
                       method)
     if method == "fast":
         df.attrs["barus_correction"] = fast_info(tables, theory, sigma_trap)
+        df.attrs["barus_time_primitive"] = served
     return df
+
+
+def _fast_rows(tables, theory, sigma_trap, sc, cs, al, h, tg, quad, out):
+    """method "fast": the rows the Barus time primitive serves (a call of one α and one E*:
+    :mod:`._barus_time`, the base engine's kernel), the others by the per-case Barus kernel
+    (:func:`._barus_fast.squeeze_kernel`), into ``out`` (:data:`BarusOut`). Returns the
+    primitive's provenance (None where it served no row)."""
+    from ._barus_fast import ratio_rows, squeeze_kernel
+    from ._barus_time import served_rows, squeeze_rows
+    setup = fast_setup(tables, theory, sigma_trap)
+    tab = tables.kernel_data(theory)
+    bg, gi, rest = served_rows(squeeze_model(tables, theory, sigma_trap), setup, cs.p0, cs.E,
+                               al, cs.us, h)
+    if gi.size:
+        over = squeeze_rows(squeeze_model(tables, theory, sigma_trap), bg, cs, tg, h, quad,
+                            out, gi)
+        if over.size:
+            rest = np.sort(np.concatenate((rest, gi[over])))
+    info = None if bg is None or rest.size == cs.p0.size else {
+        "alpha_E_star": bg.aE, "rows": int(bg.pr.xn.size), "z_nodes": int(bg.pr.nz),
+        "max_ln_p0_over_E_star": bg.x_served, "cases_served": int(cs.p0.size - rest.size)}
+    if rest.size == 0:
+        return info
+    if rest.size == cs.p0.size:
+        squeeze_kernel(tab, sc, *setup, cs, al, h, tg, *ratio_rows(*setup[:3], tg), quad, out,
+                       fast_scratch())
+        return info
+
+    def sub(a):  # the other rows as a call of their own
+        return readonly(np.ascontiguousarray(a[rest]))
+    part = BarusOut(np.empty((out.T.shape[0], rest.size)), np.empty((out.U.shape[0], rest.size)),
+                    *(np.empty(rest.size) for _ in range(4)), np.empty(rest.size, dtype=np.int8))
+    squeeze_kernel(tab, sc, *setup, Cases(*(sub(a) for a in cs)), sub(al), h, tg,
+                   *ratio_rows(*setup[:3], tg), quad, part, fast_scratch())
+    for name in BarusOut._fields:
+        if name in ("T", "U"):
+            getattr(out, name)[:, rest] = getattr(part, name)
+        else:
+            getattr(out, name)[rest] = getattr(part, name)
+    return info
 
 
 def fast_setup(tables, theory, sigma_trap):

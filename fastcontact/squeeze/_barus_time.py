@@ -1,0 +1,338 @@
+"""The Barus squeeze-out time as one primitive, for a study of one fluid on one rubber.
+
+With a Barus fluid the reduced time from v_s down to v is G(x0, v) - G(x0, v_s),
+
+    G(x0, v) = T(x0, v) + A S(x0, A, v),   A = α p0 = α E* e^x0,
+
+T the constant-viscosity time primitive (:mod:`.primitive`) and S the Barus correction of
+:mod:`._barus_primitive`. Where every case of a call shares α and E* (one oil or water, one
+tread compound: the usual tire or road study), A is a function of x0 = ln(p0/E*) alone, so G is
+a function of (x0, z) as T is: it is tabulated here on the base primitive's own rows and z
+nodes, as ln G with its first two z-derivatives (exact at the nodes),
+
+    dG/dz   = T'/g(a),                     a = A (1 - y),  y = π_c(v)/π0,
+    d²G/dz² = T''/g(a) - T' A (1/g)'(a) dy/dz,   dy/dz = y (d ln π_c/d ln v)(v - v∞)/v,
+
+(1/g(a) = 1 + a P_K(a), the same truncated series as S), and the result is a
+:data:`~._primitive_eval.Primitive`: the base engine's kernels then run the Barus cases
+unchanged (ratio targets from row tables, Δu targets and ū at the footprint time from one
+interpolation and one inversion per case) — the Barus tire at the base engine's speed.
+
+Differences to the base primitive: no closed-form tail (v_ext = inf in the record): the z
+grid is extended above the base grid's top by nodes of the closed-form flat-film tail,
+G = T_tail/g(A) there (y = 0), far enough for the call's starts; below the grid the same
+analytic part (T0 + S D + (h0 - S)(1 - e^-D), the relaxation slope S unchanged since g → 1 at
+equilibrium, where p_cont → p0). Rows end where A leaves the series' range (API_FAST, the
+stencil's rows up to three beyond it at most A_ROW_MAX, where K_MAX terms are exact to
+< 1e-12). A case is served when its x0 lies at or below ``x_served`` and its start inside the
+grid; the others keep the per-case Barus kernels.
+
+References: C. Barus, Am. J. Sci. 45, 87 (1893), doi:10.2475/ajs.s3-45.266.87;
+B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037.
+"""
+from __future__ import annotations
+
+import math
+from collections import OrderedDict
+from threading import Lock
+
+import numpy as np
+from numba import njit, prange
+
+from ..kernels.readonly import readonly, readonly_fields
+from . import _kernels as qk
+from ._barus_primitive import API_FAST, K_MAX, s_at, s_cell, series_order, shift
+from ._primitive_eval import Primitive, _index_map, _locate, lagrange_denominators
+from .viscosity import _rate_factor
+
+__all__ = ["A_ROW_MAX", "BarusTime", "barus_time"]
+
+#: largest A = α p0 of a row of the G primitive (the stencil's rows beyond API_FAST): the
+#: truncated series of K_MAX terms is exact there to c_49 A^50 < 1e-12
+A_ROW_MAX = 0.75
+
+
+class BarusTime:
+    """A G primitive (``pr``, a :data:`~._primitive_eval.Primitive`), the largest x0 it
+    serves (``x_served``) and the largest z = ln(v/v∞ - 1) + ln κ of a start it covers
+    (``z_top``)."""
+
+    __slots__ = ("pr", "x_served", "z_top", "aE")
+
+    def __init__(self, pr, x_served, z_top, aE):
+        self.pr, self.x_served, self.z_top, self.aE = pr, x_served, z_top, aE
+
+
+_MEMO: OrderedDict = OrderedDict()
+_LOCK = Lock()
+_MEMO_SIZE = 4
+
+
+def barus_time(model, pr, bt, c, x_fast, aE, z_need):
+    """The :class:`BarusTime` of ``model`` (its primitive ``pr``, Barus table ``bt``, series
+    coefficients ``c``, fast limit ``x_fast``) for α E* = ``aE`` [-], its z grid reaching
+    ``z_need`` (grid variable ζ = z + ln κ); None where fewer than four rows have A <=
+    API_FAST. Kept for the last few (model, α E*) asked (a sweep of one fluid builds it once;
+    a taller grid asked later is built again)."""
+    key = (model.key(), float(aE))
+    with _LOCK:
+        hit = _MEMO.get(key)
+        if hit is not None and hit.z_top >= z_need:
+            _MEMO.move_to_end(key)
+            return hit
+    nz = pr.nz
+    if z_need > pr.z0 + (nz - 1) * pr.dz:
+        nz = int(math.ceil((z_need - pr.z0) / pr.dz)) + 2
+    x_lim = math.log(API_FAST / aE)
+    xn = pr.xn
+    j_lim = int(np.searchsorted(xn, x_lim, side="right"))  # rows with A <= API_FAST
+    rows = min(xn.size, j_lim + 3)
+    while rows > 0 and aE * math.exp(xn[rows - 1]) > A_ROW_MAX:
+        rows -= 1
+    if rows < 4 or j_lim < 1:
+        return None
+    xg = np.ascontiguousarray(xn[:rows])
+    C = np.empty((rows, nz, 3))
+    _build_kernel(pr, bt, c, float(aE), nz, C)
+    rec = readonly_fields(Primitive(xg, *_index_map(xg), lagrange_denominators(xg), pr.z0, pr.dz,
+                                    nz, C, *(np.ascontiguousarray(a[:rows]) for a in
+                                             (pr.lnv, pr.lnS, pr.zs, pr.lk)),
+                                    math.inf, pr.c, pr.d))
+    out = BarusTime(rec, float(min(x_fast, x_lim, xg[-1])), pr.z0 + (nz - 1) * pr.dz, aE)
+    with _LOCK:
+        _MEMO[key] = out
+        _MEMO.move_to_end(key)
+        while len(_MEMO) > _MEMO_SIZE:
+            _MEMO.popitem(last=False)
+    return out
+
+
+@njit(cache=True)
+def _lnp_slope(bt, s):
+    """d ln π_c/d ln v of the correction table's cubic Hermite of ln π_c at s = ln v (the
+    derivative of the interpolant :func:`~._barus_primitive.s_cell` evaluates)."""
+    sn = bt.xn
+    i = _locate(bt, s)
+    if i < 0:
+        i = 0 if s < sn[0] else sn.size - 2
+    h = sn[i + 1] - sn[i]
+    t = (s - sn[i]) / h
+    ST = bt.ST
+    return ((6.0 * t * t - 6.0 * t) * (ST[i, 0] - ST[i + 1, 0]) / h
+            + (3.0 * t * t - 4.0 * t + 1.0) * ST[i, 1] + (3.0 * t * t - 2.0 * t) * ST[i + 1, 1])
+
+
+@njit(cache=True)
+def _g_series(c, K, a):
+    """(1/g(a), d(1/g)/da) of the truncated series 1/g = 1 + a P_K(a)."""
+    p = 0.0
+    dp = 0.0
+    for k in range(K, -1, -1):
+        dp = dp * a + p
+        p = p * a + c[k]
+    return 1.0 + a * p, p + a * dp
+
+
+@njit(parallel=True, cache=True)
+def _build_kernel(pr, bt, c, aE, nz, C):
+    """ln G and its first two z-derivatives at every (row, node) of C (rows, nz, 3)."""
+    for jj in prange(C.shape[0]):
+        j = np.int64(jj)
+        _build_row(pr, bt, c, aE, nz, j, C)
+
+
+@njit(cache=True)
+def _build_row(pr, bt, c, aE, nz, j, C):
+    x0 = pr.xn[j]
+    A = aE * math.exp(x0)
+    K = series_order(c, A)
+    if K < 0:
+        K = K_MAX
+    E = np.empty(K_MAX + 1)
+    shift(c, A, K, E)
+    vinf = math.exp(pr.lnv[j])
+    lk = pr.lk[j]
+    for k in range(nz):
+        z = pr.z0 + k * pr.dz - lk  # ln(v/v∞ - 1)
+        ez = math.exp(z)
+        v = vinf * (1.0 + ez)
+        if k < pr.nz:
+            T = math.exp(pr.C[j, k, 0])
+            L1, L2 = pr.C[j, k, 1], pr.C[j, k, 2]
+        else:  # above the base grid: the closed-form flat-film tail (v >= v_ext here)
+            y_ = v + pr.d
+            T = qk._tail_int(pr.c, y_, math.inf)
+            den = y_ * (y_ * y_ - pr.c)
+            dT = -1.0 / den  # dT/dv
+            d2T = (3.0 * y_ * y_ - pr.c) / (den * den)
+            dv = vinf * ez  # dv/dz
+            L1 = dT * dv / T
+            L2 = (d2T * dv * dv + dT * dv) / T - L1 * L1
+        s = math.log(v)
+        S, y = s_at(bt, E, K, x0, v, s)
+        a = A * (1.0 - y)
+        ig, dig = _g_series(c, K, a)
+        T1 = T * L1
+        T2 = T * (L2 + L1 * L1)
+        dy = 0.0 if y == 0.0 else y * _lnp_slope(bt, s) * (vinf * ez) / v
+        G = T + A * S
+        G1 = T1 * ig
+        G2 = T2 * ig - T1 * A * dig * dy
+        l1 = G1 / G
+        C[j, k, 0] = math.log(G)
+        C[j, k, 1] = l1
+        C[j, k, 2] = G2 / G - l1 * l1
+
+
+def served_rows(model, setup, p, E, alpha, us_in, h):
+    """(BarusTime or None, indices of the rows it serves, indices of the others) of Barus
+    cases (p0 [Pa], E* [Pa], α [1/Pa], ū(0) [m] (NaN: the default start) per row): the G
+    primitive serves a call whose rows share α and E* — rows with ln(p0/E*) in the tables and
+    at most ``x_served``, a start finite (or the default); the grid is built to reach the
+    highest such start."""
+    n = p.size
+    every = np.arange(n)
+    if n == 0 or not (alpha.min() == alpha.max() and E.min() == E.max()) or alpha[0] <= 0.0:
+        return None, every[:0], every
+    pr, bt, c, x_fast = setup
+    aE = float(alpha[0] * E[0])
+    x0 = np.log(p / E)
+    x_hi = min(x_fast, math.log(API_FAST / aE))
+    ok = (x0 >= model.mp.x_min) & (x0 <= x_hi) & ~(us_in == math.inf)
+    if not ok.any():
+        return None, every[:0], every
+    v_s = us_in[ok] / h
+    v_max = float(np.max(v_s[np.isfinite(v_s)], initial=0.0))
+    rows = int(np.searchsorted(pr.xn, x_hi, side="right")) + 3
+    vinf_min = math.exp(float(np.min(pr.lnv[:rows])))
+    z_need = pr.z0 + (pr.nz - 1) * pr.dz
+    if v_max > vinf_min:
+        z_need = max(z_need, math.log(v_max / vinf_min - 1.0) + float(np.max(pr.lk[:rows])))
+    bg = barus_time(model, pr, bt, c, x_fast, aE, z_need)
+    if bg is None:
+        return None, every[:0], every
+    ok &= x0 <= bg.x_served
+    return bg, every[ok], every[~ok]
+
+
+def tire_rows(model, bg, cs, t_fp, h, ratios, dvs, quad, res, idx):
+    """The Barus tire rows ``idx`` of the cases ``cs`` (:class:`~._kernels.Cases`, footprint
+    times t_fp [s], size 0: no exit asked) by the base engine's fast kernel on the G primitive
+    ``bg`` (:class:`BarusTime`), into ``res`` (:data:`~.tire_piezo.TireOut`): targets t_star,
+    the ratios, Δu = dvs h_rms [m] (reduced ``dvs``), ū at the footprint exit."""
+    from ._fastpath import fast_kernel, row_targets
+
+    ng = idx.size
+    every = ng == res.u_inf.size  # every row: the kernel writes into res itself
+
+    def sub(a):
+        return a if a.size == 1 or every else readonly(np.ascontiguousarray(a[idx]))
+
+    csg = qk.Cases(*(sub(a) for a in cs))
+    times2d = (readonly(sub(t_fp).reshape(1, -1)) if t_fp.size else np.empty((0, 1)))
+    tg = readonly_fields(qk.Targets(np.ascontiguousarray(ratios, dtype=np.float64),
+                                    np.ascontiguousarray(dvs, dtype=np.float64), times2d))
+    us = csg.us
+    shared = ng > 1 and (us.size == 1 or us.min() == us.max())
+    rt = row_targets(bg.pr, tg.ratios, tg.dvs, us[0] / h if shared else math.nan)
+    if every:  # status codes: the base engine's names come first in the Barus tire's
+        U = res.u_exit.reshape(1, -1) if t_fp.size else np.empty((0, ng))
+        out = qk.SqOut(res.T, U, res.u_inf, res.u_start, np.empty(ng), res.u_trap,
+                       np.empty(ng), res.flf, np.empty(ng), res.status)
+        fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, csg, h, tg, quad, out, False)
+        if not t_fp.size:
+            res.u_exit[:] = math.nan
+        return
+    out = qk.SqOut(np.empty((res.T.shape[0], ng)), np.empty((times2d.shape[0], ng)),
+                   *(np.empty(ng) for _ in range(7)), np.empty(ng, dtype=np.int8))
+    fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, csg, h, tg, quad, out, False)
+    res.T[:, idx] = out.T
+    res.u_exit[idx] = out.U[0] if t_fp.size else math.nan
+    res.u_inf[idx] = out.u_inf
+    res.u_start[idx] = out.u_start
+    res.u_trap[idx] = out.u_trap
+    res.flf[idx] = out.flf
+    res.status[idx] = out.status
+
+
+def squeeze_rows(model, bg, cs, tg, h, quad, out, idx):
+    """The Barus squeeze-out rows ``idx`` of the cases ``cs`` by the base engine's fast kernel
+    on the G primitive ``bg``, into ``out`` (:data:`~.viscosity.BarusOut`; ``tg`` its
+    :data:`~.viscosity.BarusTargets`, t_star's ratio first): target times, ū at the times,
+    ū∞, ū(0), τ0, the rate factor g at the start and the status. Returns the indices (into
+    ``idx``'s rows) the base kernel flagged "overflow" (τ0 or a time not representable),
+    which the Barus engine has no status for: the caller runs them by its per-case kernel."""
+    from ._fastpath import fast_kernel, row_targets
+    from .model import DEFAULT_P_START
+    from .viscosity import ST_BELOW, ST_OK
+
+    ng = idx.size
+    every = ng == out.u_inf.size  # every row: the kernel writes into out itself
+
+    def sub(a):
+        return a if a.size == 1 or every else readonly(np.ascontiguousarray(a[idx]))
+
+    csg = qk.Cases(*(sub(a) for a in cs))
+    times2d = np.ascontiguousarray(tg.times[:, None])
+    tgb = readonly_fields(qk.Targets(np.ascontiguousarray(tg.ratios[1:]), tg.dvs, times2d))
+    us = csg.us
+    shared = ng > 1 and (us.size == 1 or us.min() == us.max())
+    rt = row_targets(bg.pr, tgb.ratios, tgb.dvs, us[0] / h if shared else math.nan)
+    code = np.empty(ng, dtype=np.int8)
+    if every:
+        o = qk.SqOut(out.T, out.U, out.u_inf, out.u_start, np.empty(ng), np.empty(ng),
+                     np.empty(ng), np.empty(ng), out.tau0, code)
+        gs = out.g_start
+    else:
+        o = qk.SqOut(np.empty((out.T.shape[0], ng)), np.empty((times2d.shape[0], ng)),
+                     *(np.empty(ng) for _ in range(7)), code)
+        gs = np.empty(ng)
+    fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, csg, h, tgb, quad, o, True)
+    # the default start is where p_cont = DEFAULT_P_START p0: y there needs no table
+    y_default = DEFAULT_P_START if np.isnan(us).all() else -1.0
+    status = out.status if every else np.empty(ng, dtype=np.int8)
+    _g_start_kernel(model.barus_table()[0], bg.aE, csg.p0, csg.E, o.u_start, h, y_default,
+                    code, np.int8(ST_OK), np.int8(ST_BELOW), gs, status)
+    if not every:
+        out.T[:, idx] = o.T
+        out.U[:, idx] = o.U
+        out.u_inf[idx] = o.u_inf
+        out.u_start[idx] = o.u_start
+        out.tau0[idx] = o.tau0
+        out.g_start[idx] = gs
+        out.status[idx] = status
+    return np.flatnonzero((code != qk.ST_OK) & (code != qk.ST_BELOW))
+
+
+@njit(parallel=True, cache=True)
+def _g_start_kernel(bt, aE, p0, E, u_start, h, y_default, code, st_ok, st_below, gs, status):
+    """Per row (p0 [Pa] and E* [Pa] one per row or one for all, ū(0) [m] and the base
+    kernel's status ``code``): g(α p0 (1 - y)), y = π_c(v_s)/π0 at the start v_s = ū(0)/h
+    (``y_default`` >= 0: every start the default one, y = y_default) into gs, NaN where the
+    start is at or below ū∞; the Barus engine's status (``st_ok`` / ``st_below``) into
+    ``status``."""
+    n = u_start.size
+    for b in prange((n + 255) // 256):
+        _g_start_rows(bt, aE, p0, E, u_start, h, y_default, code, st_ok, st_below, gs, status,
+                      b * 256, min(b * 256 + 256, n))
+
+
+@njit(cache=True)
+def _g_start_rows(bt, aE, p0, E, u_start, h, y_default, code, st_ok, st_below, gs, status, b0,
+                  b1):
+    sp = 1 if p0.size > 1 else 0
+    sE = 1 if E.size > 1 else 0
+    for i in range(b0, b1):
+        if code[i] == qk.ST_BELOW:
+            gs[i] = math.nan
+            status[i] = st_below
+            continue
+        status[i] = st_ok
+        x0 = math.log(p0[i * sp] / E[i * sE])
+        y = y_default
+        if y < 0.0:
+            vs = u_start[i] / h
+            y = 0.0
+            if vs < bt.v_ext:
+                y = math.exp(s_cell(bt, math.log(vs))[5] - x0)
+        gs[i] = _rate_factor(aE * (p0[i * sp] / E[i * sE]) * (1.0 - y))
