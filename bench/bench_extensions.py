@@ -278,8 +278,41 @@ def bench_seal(lines, tables, quick, summary):
               f"{1e3 * t_short:.3f} ms/call reading a kept β table, {1e3 * t_short_cold:.3f} "
               f"ms/call by the sweep kernel (no table kept), base {1e3 * t_short_base:.3f} "
               f"ms/call.", ""]
-    summary.append(("Barus seal", f"O-ring {e_pan:.1e} by panels (DOP853 shooting)",
-                    f"O-ring {dps.size / t_pan:.3g} rows/s (rows cold, no chains "
+    # a study of many O-rings of one fluid (p_b = 0): the fluid's verified table of W
+    no, al_t = (4000 if quick else 20000), 3e-6
+    rng = np.random.default_rng(7)
+    pHo = np.exp(rng.uniform(math.log(2e-3), math.log(0.05), no)) * E
+    ao = 2e-3 * 2.0 * pHo / E                      # R = 2 mm: p_H = E* a/(2R)
+    okw = dict(profile="hertz", R=2e-3, f_N=math.pi * ao * pHo / 2.0,
+               dp=rng.uniform(1e-3, 0.99, no) * pHo, L_y=Ly, E_star=E, eta=ETA, theory="emt")
+    sc_o = viscosity_mod.seal_context(tables, "emt")
+    sc_o.hertz_piezo.clear()
+    t0 = time.perf_counter()
+    q_tab = seal_leak_piezo(tables, alpha_pv=al_t, **okw).Q.to_numpy()
+    t_first = time.perf_counter() - t0
+    t_tab = timed(lambda: seal_leak_piezo(tables, alpha_pv=al_t, **okw), 3)
+    with mock.patch.object(viscosity_mod, "TABLE_MIN_ROWS", 10 ** 12):
+        t0 = time.perf_counter()
+        q_dir = seal_leak_piezo(tables, alpha_pv=al_t, **okw).Q.to_numpy()
+        t_dir = time.perf_counter() - t0
+    t_base = timed(lambda: seal_leak(tables, **okw), 3)
+    fin = np.isfinite(q_dir) & (q_dir > 0)
+    e_tab = float(np.max(np.abs(q_tab[fin] / q_dir[fin] - 1)))
+    e_ref = max(abs(q_tab[i] / (hertz_shoot(sig, pHo[i], ao[i], okw["dp"][i], 0.0, al_t) * Ly)
+                    - 1) for i in (3, 11))
+    lines += [f"O-rings of one fluid (p_b = 0; {no} O-rings, p_H/E* 2e-3…0.05, Δp/p_H "
+              f"1e-3…0.99, α = {al_t:g} 1/Pa: α p_H up to {al_t * pHo.max():.2f}): W from the "
+              f"fluid's verified table (fastcontact/seal/hertz.py, per α E*, built by the first "
+              f"call of at least {viscosity_mod.TABLE_MIN_ROWS} such rows and kept): "
+              f"{no / t_tab:.3g} rows/s (the call that builds it {no / t_first:.3g}), the "
+              f"per-row solver {no / t_dir:.3g} rows/s, base `seal_leak` (its table) "
+              f"{no / t_base:.3g}; Q within {e_tab:.1e} of the solver's, {e_ref:.1e} of the "
+              f"DOP853 shooting (two rows).", ""]
+    summary.append(("Barus seal", f"O-ring {e_pan:.1e} by panels (DOP853 shooting); one "
+                    f"fluid's O-ring table {e_ref:.1e} (shooting), {e_tab:.1e} (solver)",
+                    f"O-rings of one fluid from its table {no / t_tab:.3g} rows/s (base table "
+                    f"{no / t_base:.3g}; the call that builds it {no / t_first:.3g}, per-row "
+                    f"solver {no / t_dir:.3g}); O-ring sweep {dps.size / t_pan:.3g} rows/s (rows cold, no chains "
                     f"{dps.size / t_cold:.3g}; 200-step shooting "
                     f"{dps.size / t200:.3g}; base table {dps.size / tb:.3g}, base direct "
                     f"{dps.size / tbd:.3g}); flat ring, Δp sweep "

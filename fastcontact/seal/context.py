@@ -231,6 +231,7 @@ class SealContext:
         self.alpha_table = float(tables.options.get("alpha_cj", 1.0))
         self.a_perc = float(tables.options.get("a_perc", 0.5))
         self.hertz = None            # the O-ring table (fastcontact.seal.hertz), built lazily
+        self.hertz_piezo = {}        # O-ring tables of Barus fluids by α̃ = α E* (the same)
         self.build_seconds = time.perf_counter() - t_start
 
 

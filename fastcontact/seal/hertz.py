@@ -2,7 +2,9 @@
 
 :class:`HertzTable` (a flat record) holds ln W on a grid in (ln π_H, y) for p_b = 0 (see
 :mod:`._hertz`); columns are solved on demand, cells verified at their centre against the
-solver before use. Built per (tables, theory), cached on its :class:`SealContext`.
+solver before use. Built per (tables, theory), cached on its :class:`SealContext`; a Barus
+fluid's table (α̃ = α E*, p_b = 0: one α and one E* make W a function of (π_H, π_a) again)
+the same way, per α̃, the solver run with that α̃.
 """
 from __future__ import annotations
 
@@ -50,19 +52,38 @@ class HertzTable(NamedTuple):
 _LOCK = threading.Lock()
 
 
-def hertz_table(sc):
-    """The (empty, lazily filled) :class:`HertzTable` of a SealContext."""
+#: Barus fluids (α̃ = α E* > 0) whose O-ring tables a SealContext keeps (the last asked)
+PIEZO_TABLES = 4
+
+
+def hertz_table(sc, al=0.0):
+    """The (empty, lazily filled) :class:`HertzTable` of a SealContext; ``al`` > 0: the table
+    of a Barus fluid of reduced coefficient α̃ = α E* (η = η0 e^{α p_f}, p_b = 0: with one α and
+    one E*, W is again a function of (π_H, π_a) alone), kept for the last PIEZO_TABLES α̃."""
     with _LOCK:
-        if sc.hertz is None:
-            t0 = sc.rec.t_lo - 3.0
-            K = int(math.ceil((math.log(sc.p_top) - t0) / H1)) + 1
-            sc.hertz = HertzTable(t0, H1, np.full((K, NY + 1), np.nan),
-                                  np.zeros((K, NY), dtype=np.int8), np.zeros(K, dtype=np.bool_))
-        return sc.hertz
+        if al == 0.0 and sc.hertz is not None:
+            return sc.hertz
+        memo = sc.hertz_piezo
+        if al != 0.0:
+            if al in memo:
+                memo[al] = memo.pop(al)  # most recent last
+                return memo[al]
+        t0 = sc.rec.t_lo - 3.0
+        K = int(math.ceil((math.log(sc.p_top) - t0) / H1)) + 1
+        ht = HertzTable(t0, H1, np.full((K, NY + 1), np.nan), np.zeros((K, NY), dtype=np.int8),
+                        np.zeros(K, dtype=np.bool_))
+        if al == 0.0:
+            sc.hertz = ht
+        else:
+            memo[al] = ht
+            while len(memo) > PIEZO_TABLES:
+                memo.pop(next(iter(memo)))
+        return ht
 
 
-def _solve_W(sc, piH, pia, equal):
-    """W of (π_H, π_a) points (p_b = 0) with the table's tight solver settings."""
+def _solve_W(sc, piH, pia, equal, al=0.0):
+    """W of (π_H, π_a) points (p_b = 0; Barus α̃ = ``al``) with the table's tight solver
+    settings."""
     o = solver_options(None)
     out = RowsOut.empty(piH.size)
     for sel, eq in ((~equal, False), (equal, True)):
@@ -72,12 +93,12 @@ def _solve_W(sc, piH, pia, equal):
         rule = panel_rule(o, tol=1e-9 if eq else TABLE_TOL, max_panels=256)
         _panels.solve_rows(sc.tab, sc.rec, rule, 0, np.zeros(2), np.zeros(2),
                            np.ascontiguousarray(piH), np.ascontiguousarray(pia),
-                           np.zeros(piH.size), np.zeros(piH.size), np.zeros((piH.size, 0)),
-                           idx.astype(np.int64), out)
+                           np.zeros(piH.size), np.full(piH.size, float(al)),
+                           np.zeros((piH.size, 0)), idx.astype(np.int64), out)
     return np.where(out.status == _panels.ST_NEWTON_FAILED, np.nan, out.W)
 
 
-def _build_rows(sc, ht, ks):
+def _build_rows(sc, ht, ks, al=0.0):
     """Solve the grid rows ks (all y nodes)."""
     ks = np.asarray([k for k in ks if not ht.built[k]], dtype=np.int64)
     if not ks.size:
@@ -88,17 +109,17 @@ def _build_rows(sc, ht, ks):
     r[-1] = 1.0
     piH = np.repeat(np.exp(ht.t0 + ht.h1 * ks), NY + 1)
     rr = np.tile(r, ks.size)
-    W = _solve_W(sc, piH, rr * piH, np.tile(np.arange(NY + 1) == NY, ks.size))
+    W = _solve_W(sc, piH, rr * piH, np.tile(np.arange(NY + 1) == NY, ks.size), al)
     with np.errstate(divide="ignore", invalid="ignore"):
         ht.lw[ks] = np.log(W).reshape(ks.size, NY + 1)
     ht.built[ks] = True
 
 
-def _verify_cells(sc, ht, kc, jc):
+def _verify_cells(sc, ht, kc, jc, al=0.0):
     """Solve at the centres of cells (kc, jc) and compare with the interpolation."""
     piH = np.exp(ht.t0 + ht.h1 * (kc + 0.5))
     pia = piH * np.array([_hertz.ra_of_y((j + 0.5) / NY) for j in jc])
-    W = _solve_W(sc, piH, pia, np.zeros(kc.size, dtype=bool))
+    W = _solve_W(sc, piH, pia, np.zeros(kc.size, dtype=bool), al)
     est = np.empty(kc.size)
     _hertz.hertz_interp(ht, piH, pia, np.arange(kc.size, dtype=np.int64), True, est)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -106,9 +127,10 @@ def _verify_cells(sc, ht, kc, jc):
     ht.cell[kc, jc] = np.where(good, 1, 2)
 
 
-def table_W(sc, piH, pia, rows):
-    """W [-] of the rows (p_b = 0) from the table; NaN where the solver must be used."""
-    ht = hertz_table(sc)
+def table_W(sc, piH, pia, rows, al=0.0):
+    """W [-] of the rows (p_b = 0) from the table (of the Barus fluid α̃ = ``al`` > 0, one
+    for every row); NaN where the solver must be used."""
+    ht = hertz_table(sc, float(al))
     K = ht.lw.shape[0]
     t = np.log(piH[rows])
     k = np.floor((t - ht.t0) / ht.h1).astype(np.int64)
@@ -122,8 +144,8 @@ def table_W(sc, piH, pia, rows):
         todo = ht.cell[kc, jc] == 0
         if todo.any():
             need = np.unique((kc[todo][:, None] + np.arange(-2, 4)[None, :]).ravel())
-            _build_rows(sc, ht, need[(need >= 0) & (need < K)])
-            _verify_cells(sc, ht, kc[todo], jc[todo])
+            _build_rows(sc, ht, need[(need >= 0) & (need < K)], al)
+            _verify_cells(sc, ht, kc[todo], jc[todo], al)
     lnW = np.full(piH.size, np.nan)
     sel = rows[inside]
     _hertz.hertz_interp(ht, piH, pia, np.ascontiguousarray(sel, dtype=np.int64), False, lnW)

@@ -156,7 +156,10 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         half as many steps: Barus with FALLBACK_STEPS, Roelands with HERTZ_STEPS, then, where
         the two differ by more than FALLBACK_RTOL, with FALLBACK_STEPS; "not_converged"
         (Q = NaN) where they still differ. An integer: shooting with that many steps,
-        unchecked (both laws).
+        unchecked (both laws). A Barus call of at least TABLE_MIN_ROWS O-rings of one α and
+        one E* (p_b = 0) reads W from that fluid's verified O-ring table
+        (:mod:`fastcontact.seal.hertz`, built once and kept; ~1e-8 of the solver) and
+        solves only the rows whose cells are not verified.
     viscosity : {"barus", "roelands"}
         Viscosity law (module docstring; :mod:`fastcontact.flow.piezoviscosity`). Roelands:
         ln(η/η0) = ln(η0/η_∞)[(1 + (p_f - p_b)/p_r)^Z - 1], its reduced pressure
@@ -556,7 +559,7 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
                                 np.empty(k.size))
         elif steps is None:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, v["alpha_pv"])]
-            k, ok = _barus_hertz_k(tables, theory, *sub)
+            k, ok = _barus_hertz_k_tabled(tables, theory, *sub)
             if not np.all(ok):   # Newton failed (α p_H >~ 5 next to lift-off): shooting
                 bad = np.flatnonzero(~ok)
                 k[bad], ok[bad] = _checked_shooting(
@@ -642,6 +645,38 @@ def _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha):
         psia = np.where(alpha > 0.0, -np.expm1(-alpha * dp) / np.where(alpha > 0.0, alpha, 1.0),
                         dp)
     return _panel_hertz_k(tables, theory, E, pH, a, pa, pb, psia, al=alpha * E)
+
+
+def _barus_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, alpha):
+    """:func:`_barus_hertz_k`, with the rows of one Barus fluid on one rubber (one α̃ = α E*,
+    p_b = 0, below lift-off) from the fluid's verified O-ring table
+    (:func:`fastcontact.seal.hertz.table_W`; ~1e-7 in W as the base O-ring's); the others,
+    and the rows whose cells are not verified, by the solver."""
+    al = alpha * E
+    n = E.size
+    if n < TABLE_MIN_ROWS or not (al.min() == al.max() and al[0] > 0.0):
+        return _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha)
+    from .hertz import table_W
+    sc = seal_context(tables, theory)
+    piH = np.ascontiguousarray(pH / E)
+    pia = np.ascontiguousarray(pa / E)
+    W = table_W(sc, piH, pia, np.flatnonzero((pb == 0.0) & (pa < pH)), float(al[0]))
+    fast = np.isfinite(W)
+    k = np.empty(n)
+    ok = np.ones(n, dtype=bool)
+    dp = pa - pb
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k[fast] = -np.expm1(-alpha[fast] * dp[fast]) / alpha[fast] / (a[fast] * W[fast])
+    rest = np.flatnonzero(~fast)
+    if rest.size:
+        k[rest], ok[rest] = _barus_hertz_k(tables, theory, *(x[rest] for x in
+                                                             (E, pH, a, pa, pb, alpha)))
+    return k, ok
+
+
+#: fewest O-ring rows of one Barus fluid for which :func:`_barus_hertz_k_tabled` reads (and
+#: builds, ~0.1-1 s) the fluid's table instead of solving each row (~70 µs a row)
+TABLE_MIN_ROWS = 2000
 
 
 def _roelands_hertz_k(tables, theory, E, pH, a, pa, pb, A, Z, pr):
