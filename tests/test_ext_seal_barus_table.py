@@ -1,4 +1,4 @@
-"""Issue 14.5: Barus O-rings of one fluid on one rubber from a verified table of W.
+"""Issue 14.5: Barus and Roelands O-rings of one fluid on one rubber from a verified table of W.
 
 With one α and one E* (p_b = 0) the reduced resistance W of a Barus O-ring is a function of
 (π_H, π_a) alone, so the base O-ring table (``fastcontact/seal/hertz.py``) serves it: built per
@@ -36,10 +36,12 @@ def tables():
     return fc.precompute(psd, theories=("critical_junction", "emt"))
 
 
-def _orings(n, seed, alpha):
-    """n O-rings of radius R: p_H/E* log-uniform in [2e-3, 0.02], Δp/p_H in [1e-3, 0.99]."""
+def _orings(n, seed, alpha, designs=None):
+    """n O-rings of radius R: p_H/E* log-uniform in [2e-3, 0.02] (``designs``: that many
+    O-rings, each in a Δp sweep), Δp/p_H in [1e-3, 0.99]."""
     rng = np.random.default_rng(seed)
-    pH = np.exp(rng.uniform(math.log(2e-3), math.log(0.02), n)) * E_STAR
+    lp = rng.uniform(math.log(2e-3), math.log(0.02), designs or n)
+    pH = np.exp(lp if designs is None else np.repeat(lp, -(-n // designs))[:n]) * E_STAR
     a = 2.0 * R * pH / E_STAR                  # Hertz line contact: p_H = E* a/(2R)
     f_N = math.pi * a * pH / 2.0
     dp = rng.uniform(1e-3, 0.99, n) * pH
@@ -55,11 +57,13 @@ def _solver_only(tables, kw, monkeypatch):
 
 @pytest.mark.parametrize("theory", ["critical_junction", "emt"])
 def test_table_against_the_solver(tables, theory, monkeypatch):
-    """2,500 O-rings of one fluid (α p_H up to 0.8): Q from the fluid's table within 1e-7 of
-    the per-row solver, the same statuses; the table is the one of that α̃ and serves most
-    rows; a call of two fluids, or with p_b > 0, is the solver's, number for number."""
+    """Δp sweeps of 4 O-rings of one fluid (6,000 rows, α p_H up to 0.8): Q from the fluid's
+    table within 1e-7 of the per-row solver, the same statuses; the table is the one of that
+    α̃ and serves most rows; a call of two fluids, or with p_b > 0, is the solver's, number
+    for number; 600 O-rings of a wide spread of contact pressures, each its own, do not pay
+    for a table of their own (solved), and read it once it is kept."""
     alpha = 4e-6
-    kw, _pH, _a = _orings(2500, 1, alpha)
+    kw, _pH, _a = _orings(6000, 1, alpha, designs=4)
     kw["theory"] = theory
     calls = []
     real = sh.table_W
@@ -76,16 +80,27 @@ def test_table_against_the_solver(tables, theory, monkeypatch):
     ref = _solver_only(tables, kw, monkeypatch)
     assert list(got.status) == list(ref.status)
     ok = (ref.status == "ok").to_numpy()
-    assert ok.sum() > 2000
+    assert ok.sum() > 5000
     np.testing.assert_allclose(got.Q[ok], ref.Q[ok], rtol=1e-7, atol=0)
     calls.clear()
-    two = dict(kw, alpha_pv=np.where(np.arange(2500) % 2 == 0, alpha, 0.5 * alpha))
+    two = dict(kw, alpha_pv=np.where(np.arange(6000) % 2 == 0, alpha, 0.5 * alpha))
     np.testing.assert_array_equal(seal_leak_piezo(tables, **two).Q,
                                   _solver_only(tables, two, monkeypatch).Q)
     back = dict(kw, p_b=1e3)
     np.testing.assert_array_equal(seal_leak_piezo(tables, **back).Q,
                                   _solver_only(tables, back, monkeypatch).Q)
     assert calls == [] or all(c[1] == 0 for c in calls)
+    wide, _pH, _a = _orings(600, 4, 0.5 * alpha)
+    wide["theory"] = theory
+    calls.clear()
+    np.testing.assert_array_equal(seal_leak_piezo(tables, **wide).Q,
+                                  _solver_only(tables, wide, monkeypatch).Q)
+    assert calls == []                                         # not worth a table
+    seal_leak_piezo(tables, **dict(wide, dp=np.repeat(wide["dp"], 40),
+                                   f_N=np.repeat(wide["f_N"], 40)))  # 24,000 rows: built
+    again = seal_leak_piezo(tables, **wide)                           # now read
+    assert calls[-1][1] > 0.9 * calls[-1][2]
+    np.testing.assert_allclose(again.Q, _solver_only(tables, wide, monkeypatch).Q, rtol=1e-7)
 
 
 def test_table_against_shooting_reference(tables):
@@ -93,7 +108,7 @@ def test_table_against_shooting_reference(tables):
     η(p) in p (no reduced pressure): within 3e-7 (the table's cells are verified to 2e-7 in
     ln W against the solver, whose own error is ~1e-10)."""
     alpha = 2e-5                                   # α p_H from 0.4 to 4
-    kw, pH, a = _orings(2500, 2, alpha)
+    kw, pH, a = _orings(2500, 2, alpha, designs=2)
     kw["theory"] = "emt"
     got = seal_leak_piezo(tables, **kw)
     ht = sh.hertz_table(sv.seal_context(tables, "emt"), alpha * E_STAR)
@@ -105,9 +120,38 @@ def test_table_against_shooting_reference(tables):
         return tables.conductivity(np.maximum(pc, plo * (1 + 1e-7)), E_STAR, ETA, "emt")
 
     sc = sv.seal_context(tables, "emt")
-    rows = np.array([3, 11, 17])
+    rows = np.array([3, 11, 2000])
     W = sh.table_W(sc, pH / E_STAR, (kw["dp"]) / E_STAR, rows, alpha * E_STAR)
     assert np.all(np.isfinite(W[rows]))                        # these rows: from the table
+    assert np.unique(pH[rows]).size == 2                       # both O-rings
     for i in rows:
         ref = hertz_shoot(sigma, pH[i], a[i], kw["dp"][i], 0.0, alpha) * L_Y
         assert abs(got.Q[i] / ref - 1) < 3e-7, i
+
+
+def test_roelands_table_against_the_solver(tables, monkeypatch):
+    """A Roelands fluid's O-rings (one law, Δp sweeps of 4 O-rings, 6,000 rows; the table
+    keyed by the law (A, Z, p_r/E*)): Q within 1e-7 of the per-row solver, the same
+    statuses, most rows from the table; a second law in the call: the solver's numbers."""
+    kw, _pH, _a = _orings(6000, 3, 4e-6, designs=4)
+    kw.update(theory="emt", viscosity="roelands", roelands_z=0.6, roelands_p_r=2e5)
+    calls = []
+    real = sh.table_W
+
+    def spy(sc, piH, pia, rows, al=0.0, vis=None):
+        W = real(sc, piH, pia, rows, al, vis)
+        calls.append((vis, int(np.isfinite(W[rows]).sum()), rows.size))
+        return W
+
+    monkeypatch.setattr(sh, "table_W", spy)
+    got = seal_leak_piezo(tables, **kw)
+    assert len(calls) == 1 and calls[0][0] is not None and calls[0][0][1] == 0.6
+    assert calls[0][1] > 0.8 * calls[0][2]
+    ref = _solver_only(tables, kw, monkeypatch)
+    assert list(got.status) == list(ref.status)
+    ok = (ref.status == "ok").to_numpy()
+    assert ok.sum() > 5000
+    np.testing.assert_allclose(got.Q[ok], ref.Q[ok], rtol=1e-7, atol=0)
+    two = dict(kw, roelands_z=np.where(np.arange(6000) % 2 == 0, 0.6, 0.5))
+    np.testing.assert_array_equal(seal_leak_piezo(tables, **two).Q,
+                                  _solver_only(tables, two, monkeypatch).Q)

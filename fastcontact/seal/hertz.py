@@ -4,7 +4,7 @@
 :mod:`._hertz`); columns are solved on demand, cells verified at their centre against the
 solver before use. Built per (tables, theory), cached on its :class:`SealContext`; a Barus
 fluid's table (α̃ = α E*, p_b = 0: one α and one E* make W a function of (π_H, π_a) again)
-the same way, per α̃, the solver run with that α̃.
+the same way, per α̃, the solver run with that α̃; a Roelands fluid's per law (A, Z, p_r/E*).
 """
 from __future__ import annotations
 
@@ -17,7 +17,8 @@ import numpy as np
 from . import _hertz, _panels
 from .context import RowsOut, panel_rule, solver_options
 
-__all__ = ["HertzTable", "hertz_table", "table_W", "H1", "NY", "TABLE_TOL", "VERIFY_TOL"]
+__all__ = ["HertzTable", "hertz_table", "table_W", "table_cost", "H1", "NY", "TABLE_TOL",
+           "VERIFY_TOL"]
 
 #: grid spacing in ln π_H, number of y intervals
 H1 = 0.05
@@ -56,10 +57,18 @@ _LOCK = threading.Lock()
 PIEZO_TABLES = 4
 
 
-def hertz_table(sc, al=0.0):
+def _fluid_key(al, vis):
+    """The key of a fluid's table: 0.0 (constant viscosity), α̃ (Barus) or the Roelands law."""
+    return float(al) if vis is None else tuple(float(x) for x in vis)
+
+
+def hertz_table(sc, al=0.0, vis=None):
     """The (empty, lazily filled) :class:`HertzTable` of a SealContext; ``al`` > 0: the table
     of a Barus fluid of reduced coefficient α̃ = α E* (η = η0 e^{α p_f}, p_b = 0: with one α and
-    one E*, W is again a function of (π_H, π_a) alone), kept for the last PIEZO_TABLES α̃."""
+    one E*, W is again a function of (π_H, π_a) alone); ``vis`` = (A, Z, π_r): a Roelands
+    fluid's (the law of :mod:`fastcontact.flow.piezoviscosity`, π_r = p_r/E*); kept for the
+    last PIEZO_TABLES fluids."""
+    al = _fluid_key(al, vis)
     with _LOCK:
         if al == 0.0 and sc.hertz is not None:
             return sc.hertz
@@ -81,11 +90,13 @@ def hertz_table(sc, al=0.0):
         return ht
 
 
-def _solve_W(sc, piH, pia, equal, al=0.0):
-    """W of (π_H, π_a) points (p_b = 0; Barus α̃ = ``al``) with the table's tight solver
-    settings."""
+def _solve_W(sc, piH, pia, equal, al=0.0, vis=None):
+    """W of (π_H, π_a) points (p_b = 0; Barus α̃ = ``al``, or the Roelands law ``vis``) with
+    the table's tight solver settings."""
     o = solver_options(None)
     out = RowsOut.empty(piH.size)
+    law = (np.zeros((piH.size, 0)) if vis is None
+           else np.ascontiguousarray(np.tile(np.asarray(vis, dtype=np.float64), (piH.size, 1))))
     for sel, eq in ((~equal, False), (equal, True)):
         idx = np.flatnonzero(sel)
         if not idx.size:
@@ -93,12 +104,12 @@ def _solve_W(sc, piH, pia, equal, al=0.0):
         rule = panel_rule(o, tol=1e-9 if eq else TABLE_TOL, max_panels=256)
         _panels.solve_rows(sc.tab, sc.rec, rule, 0, np.zeros(2), np.zeros(2),
                            np.ascontiguousarray(piH), np.ascontiguousarray(pia),
-                           np.zeros(piH.size), np.full(piH.size, float(al)),
-                           np.zeros((piH.size, 0)), idx.astype(np.int64), out)
+                           np.zeros(piH.size), np.full(piH.size, float(al)), law,
+                           idx.astype(np.int64), out)
     return np.where(out.status == _panels.ST_NEWTON_FAILED, np.nan, out.W)
 
 
-def _build_rows(sc, ht, ks, al=0.0):
+def _build_rows(sc, ht, ks, al=0.0, vis=None):
     """Solve the grid rows ks (all y nodes)."""
     ks = np.asarray([k for k in ks if not ht.built[k]], dtype=np.int64)
     if not ks.size:
@@ -109,17 +120,17 @@ def _build_rows(sc, ht, ks, al=0.0):
     r[-1] = 1.0
     piH = np.repeat(np.exp(ht.t0 + ht.h1 * ks), NY + 1)
     rr = np.tile(r, ks.size)
-    W = _solve_W(sc, piH, rr * piH, np.tile(np.arange(NY + 1) == NY, ks.size), al)
+    W = _solve_W(sc, piH, rr * piH, np.tile(np.arange(NY + 1) == NY, ks.size), al, vis)
     with np.errstate(divide="ignore", invalid="ignore"):
         ht.lw[ks] = np.log(W).reshape(ks.size, NY + 1)
     ht.built[ks] = True
 
 
-def _verify_cells(sc, ht, kc, jc, al=0.0):
+def _verify_cells(sc, ht, kc, jc, al=0.0, vis=None):
     """Solve at the centres of cells (kc, jc) and compare with the interpolation."""
     piH = np.exp(ht.t0 + ht.h1 * (kc + 0.5))
     pia = piH * np.array([_hertz.ra_of_y((j + 0.5) / NY) for j in jc])
-    W = _solve_W(sc, piH, pia, np.zeros(kc.size, dtype=bool), al)
+    W = _solve_W(sc, piH, pia, np.zeros(kc.size, dtype=bool), al, vis)
     est = np.empty(kc.size)
     _hertz.hertz_interp(ht, piH, pia, np.arange(kc.size, dtype=np.int64), True, est)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -127,10 +138,11 @@ def _verify_cells(sc, ht, kc, jc, al=0.0):
     ht.cell[kc, jc] = np.where(good, 1, 2)
 
 
-def table_W(sc, piH, pia, rows, al=0.0):
-    """W [-] of the rows (p_b = 0) from the table (of the Barus fluid α̃ = ``al`` > 0, one
-    for every row); NaN where the solver must be used."""
-    ht = hertz_table(sc, float(al))
+def table_W(sc, piH, pia, rows, al=0.0, vis=None):
+    """W [-] of the rows (p_b = 0) from the table (of the Barus fluid α̃ = ``al`` > 0, or the
+    Roelands law ``vis`` = (A, Z, π_r), one for every row); NaN where the solver must be
+    used."""
+    ht = hertz_table(sc, al, vis)
     K = ht.lw.shape[0]
     t = np.log(piH[rows])
     k = np.floor((t - ht.t0) / ht.h1).astype(np.int64)
@@ -144,12 +156,30 @@ def table_W(sc, piH, pia, rows, al=0.0):
         todo = ht.cell[kc, jc] == 0
         if todo.any():
             need = np.unique((kc[todo][:, None] + np.arange(-2, 4)[None, :]).ravel())
-            _build_rows(sc, ht, need[(need >= 0) & (need < K)], al)
-            _verify_cells(sc, ht, kc[todo], jc[todo], al)
+            _build_rows(sc, ht, need[(need >= 0) & (need < K)], al, vis)
+            _verify_cells(sc, ht, kc[todo], jc[todo], al, vis)
     lnW = np.full(piH.size, np.nan)
     sel = rows[inside]
     _hertz.hertz_interp(ht, piH, pia, np.ascontiguousarray(sel, dtype=np.int64), False, lnW)
     return np.exp(lnW)
+
+
+def table_cost(sc, piH, pia, rows, al=0.0, vis=None):
+    """Solver calls that :func:`table_W` of these rows would make before it can answer: the
+    grid rows it still has to build (NY + 1 nodes each, with the stencil's neighbours) and the
+    cells it still has to verify (one each) — to compare with solving the rows themselves."""
+    ht = hertz_table(sc, al, vis)
+    K = ht.lw.shape[0]
+    t = np.log(piH[rows])
+    k = np.floor((t - ht.t0) / ht.h1).astype(np.int64)
+    j = np.clip((_y_vec(piH[rows], pia[rows]) * NY).astype(np.int64), 0, NY - 1)
+    inside = (k >= 2) & (k <= K - 4)
+    cells = np.unique(k[inside] * NY + j[inside])
+    kc, jc = cells // NY, cells % NY
+    todo = ht.cell[kc, jc] == 0
+    need = np.unique((kc[todo][:, None] + np.arange(-2, 4)[None, :]).ravel())
+    need = need[(need >= 0) & (need < K)]
+    return int((~ht.built[need]).sum()) * (NY + 1) + int(todo.sum())
 
 
 def _y_vec(piH, pia):

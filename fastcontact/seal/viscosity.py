@@ -156,10 +156,12 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         half as many steps: Barus with FALLBACK_STEPS, Roelands with HERTZ_STEPS, then, where
         the two differ by more than FALLBACK_RTOL, with FALLBACK_STEPS; "not_converged"
         (Q = NaN) where they still differ. An integer: shooting with that many steps,
-        unchecked (both laws). A Barus call of at least TABLE_MIN_ROWS O-rings of one α and
-        one E* (p_b = 0) reads W from that fluid's verified O-ring table
-        (:mod:`fastcontact.seal.hertz`, built once and kept; ~1e-8 of the solver) and
-        solves only the rows whose cells are not verified.
+        unchecked (both laws). A call of at least TABLE_MIN_ROWS O-rings of one fluid (α, or
+        the Roelands law) and one E* (p_b = 0) reads W from that fluid's verified O-ring table
+        (:mod:`fastcontact.seal.hertz`, built as far as needed and kept; ~1e-8 of the solver)
+        where building what it lacks costs fewer solves than the rows (Δp sweeps of a few
+        O-rings, a large study, a table kept from an earlier call), and solves only the rows
+        whose cells are not verified.
     viscosity : {"barus", "roelands"}
         Viscosity law (module docstring; :mod:`fastcontact.flow.piezoviscosity`). Roelands:
         ln(η/η0) = ln(η0/η_∞)[(1 + (p_f - p_b)/p_r)^Z - 1], its reduced pressure
@@ -547,7 +549,7 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
         if law is not None:
             sub = [np.ascontiguousarray(x[run]) for x in (E, pH, a, pa, pb, law[0], law[1])]
             if steps is None:
-                k, ok = _roelands_hertz_k(tables, theory, *sub, law[2])
+                k, ok = _roelands_hertz_k_tabled(tables, theory, *sub, law[2])
                 if not np.all(ok):   # Newton failed (steep laws next to lift-off): shooting
                     bad = np.flatnonzero(~ok)
                     k[bad], ok[bad] = _checked_shooting(
@@ -660,7 +662,10 @@ def _barus_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, alpha):
     sc = seal_context(tables, theory)
     piH = np.ascontiguousarray(pH / E)
     pia = np.ascontiguousarray(pa / E)
-    W = table_W(sc, piH, pia, np.flatnonzero((pb == 0.0) & (pa < pH)), float(al[0]))
+    rows = np.flatnonzero((pb == 0.0) & (pa < pH))
+    if not _table_pays(sc, piH, pia, rows, float(al[0]), None):
+        return _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha)
+    W = table_W(sc, piH, pia, rows, float(al[0]))
     fast = np.isfinite(W)
     k = np.empty(n)
     ok = np.ones(n, dtype=bool)
@@ -674,9 +679,53 @@ def _barus_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, alpha):
     return k, ok
 
 
-#: fewest O-ring rows of one Barus fluid for which :func:`_barus_hertz_k_tabled` reads (and
-#: builds, ~0.1-1 s) the fluid's table instead of solving each row (~70 µs a row)
-TABLE_MIN_ROWS = 2000
+def _roelands_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, A, Z, pr):
+    """:func:`_roelands_hertz_k`, with the rows of one Roelands fluid on one rubber (one law
+    (A, Z, p_r/E*), p_b = 0, below lift-off) from the fluid's verified O-ring table, as
+    :func:`_barus_hertz_k_tabled`."""
+    n = E.size
+    pr = np.broadcast_to(np.asarray(pr, dtype=np.float64), (n,))  # p_r: one or per row
+    prn = pr / E
+    if n < TABLE_MIN_ROWS or not all(x.min() == x.max() for x in (A, Z, prn)):
+        return _roelands_hertz_k(tables, theory, E, pH, a, pa, pb, A, Z, pr)
+    from .hertz import table_W
+    sc = seal_context(tables, theory)
+    piH = np.ascontiguousarray(pH / E)
+    pia = np.ascontiguousarray(pa / E)
+    rows = np.flatnonzero((pb == 0.0) & (pa < pH))
+    law = (A[0], Z[0], prn[0])
+    if not _table_pays(sc, piH, pia, rows, 0.0, law):
+        return _roelands_hertz_k(tables, theory, E, pH, a, pa, pb, A, Z, pr)
+    W = table_W(sc, piH, pia, rows, vis=law)
+    fast = np.flatnonzero(np.isfinite(W))
+    k = np.empty(n)
+    ok = np.ones(n, dtype=bool)
+    if fast.size:
+        psia = np.empty(fast.size)
+        psi_drops(*(np.ascontiguousarray(x[fast], dtype=np.float64) for x in
+                    (A, Z, prn, (pa - pb) / E)), psia)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k[fast] = E[fast] * psia / (a[fast] * W[fast])
+    rest = np.flatnonzero(~np.isfinite(W))
+    if rest.size:
+        k[rest], ok[rest] = _roelands_hertz_k(tables, theory, *(x[rest] for x in
+                                                                (E, pH, a, pa, pb, A, Z, pr)))
+    return k, ok
+
+
+def _table_pays(sc, piH, pia, rows, al, vis):
+    """Whether reading the fluid's O-ring table costs fewer solver calls than solving the
+    rows: the table's grid rows and cells still to build and verify (a spread of contact
+    pressures needs many; a Δp sweep of a few O-rings few; a kept table none) against the
+    rows themselves."""
+    from .hertz import table_cost
+    return table_cost(sc, piH, pia, rows, al, vis) <= rows.size
+
+
+#: fewest O-ring rows of one fluid (Barus or Roelands) for which :func:`_barus_hertz_k_tabled`
+#: and :func:`_roelands_hertz_k_tabled` consider the fluid's table (used where it pays,
+#: :func:`_table_pays`) instead of solving each row (~70-100 µs a row)
+TABLE_MIN_ROWS = 500
 
 
 def _roelands_hertz_k(tables, theory, E, pH, a, pa, pb, A, Z, pr):
