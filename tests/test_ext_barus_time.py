@@ -28,7 +28,7 @@ from fastcontact.squeeze._barus_time import served_rows  # noqa: E402
 from fastcontact.squeeze._primitive_eval import row_value, stencil, t_of_z  # noqa: E402
 from fastcontact.squeeze.model import squeeze_model  # noqa: E402
 from fastcontact.squeeze.tire import tire_footprint  # noqa: E402
-from fastcontact.squeeze.viscosity import fast_setup  # noqa: E402
+from fastcontact.squeeze.viscosity import barus_rate_factor, fast_setup  # noqa: E402
 
 E_STAR, ETA, R = 1e7, 1e-3, 0.01
 
@@ -199,6 +199,10 @@ def test_one_fluid_squeeze_out_against_quadrature_random(tables, theory):
             np.testing.assert_array_equal(a[~nz], 0.0)
         np.testing.assert_allclose(fast.rate_factor_start[ok], quad.rate_factor_start[ok],
                                    rtol=1e-7)
+        if us is None:  # the default start: p_cont = 1e-3 p0 by definition
+            np.testing.assert_allclose(fast.rate_factor_start[ok],
+                                       barus_rate_factor(alpha * p0[ok] * (1.0 - 1e-3)),
+                                       rtol=1e-11)
         names = [c for c in fast.columns if c.startswith("u_at_")]
         U, Uq = fast[names].to_numpy()[ok], quad[names].to_numpy()[ok]
         u_inf = fast.u_inf.to_numpy()[ok]

@@ -43,7 +43,7 @@ from ..kernels.readonly import readonly, readonly_fields
 from . import _kernels as qk
 from ._barus_primitive import API_FAST, K_MAX, s_at, s_cell, series_order, shift
 from ._primitive_eval import Primitive, _index_map, _locate, lagrange_denominators
-from .viscosity import _rate_factor
+from .viscosity import _rate_factor, _rate_factor_array
 
 __all__ = ["A_ROW_MAX", "BarusTime", "barus_time"]
 
@@ -54,14 +54,19 @@ A_ROW_MAX = 0.75
 
 class BarusTime:
     """A G primitive (``pr``, a :data:`~._primitive_eval.Primitive`), the largest x0 it
-    serves (``x_served``) and the largest z = ln(v/v∞ - 1) + ln κ of a start it covers
-    (``z_top``)."""
+    serves (``x_served``), the largest z = ln(v/v∞ - 1) + ln κ of a start it covers
+    (``z_top``), its α E* (``aE``) and the rate-factor tables built for it
+    (:func:`default_rate_table`)."""
 
-    __slots__ = ("pr", "x_served", "z_top", "aE")
+    __slots__ = ("pr", "x_served", "z_top", "aE", "rate_tables")
 
     def __init__(self, pr, x_served, z_top, aE):
         self.pr, self.x_served, self.z_top, self.aE = pr, x_served, z_top, aE
+        self.rate_tables = {}
 
+
+#: the rate-factor table's stand-in where none is read (a given start)
+_NO_TABLE = readonly(np.zeros(2))
 
 _MEMO: OrderedDict = OrderedDict()
 _LOCK = Lock()
@@ -291,7 +296,8 @@ def squeeze_rows(model, bg, cs, tg, h, quad, out, idx):
     # the default start is where p_cont = DEFAULT_P_START p0: y there needs no table
     y_default = DEFAULT_P_START if np.isnan(us).all() else -1.0
     status = out.status if every else np.empty(ng, dtype=np.int8)
-    _g_start_kernel(model.barus_table()[0], bg.aE, csg.p0, csg.E, o.u_start, h, y_default,
+    gx = default_rate_table(bg, y_default) if y_default >= 0.0 else _NO_TABLE
+    _g_start_kernel(model.barus_table()[0], bg.aE, csg.p0, csg.E, o.u_start, h, y_default, gx,
                     code, np.int8(ST_OK), np.int8(ST_BELOW), gs, status)
     if not every:
         out.T[:, idx] = o.T
@@ -305,34 +311,74 @@ def squeeze_rows(model, bg, cs, tg, h, quad, out, idx):
 
 
 @njit(parallel=True, cache=True)
-def _g_start_kernel(bt, aE, p0, E, u_start, h, y_default, code, st_ok, st_below, gs, status):
+def _g_start_kernel(bt, aE, p0, E, u_start, h, y_default, gx, code, st_ok, st_below, gs,
+                    status):
     """Per row (p0 [Pa] and E* [Pa] one per row or one for all, ū(0) [m] and the base
     kernel's status ``code``): g(α p0 (1 - y)), y = π_c(v_s)/π0 at the start v_s = ū(0)/h
-    (``y_default`` >= 0: every start the default one, y = y_default) into gs, NaN where the
-    start is at or below ū∞; the Barus engine's status (``st_ok`` / ``st_below``) into
-    ``status``."""
+    (``y_default`` >= 0: every start the default one, y = y_default, g read from ``gx`` =
+    (x_first, dx, g at x_first + k dx...) of :func:`default_rate_table`, 4-point Lagrange in
+    x0) into gs, NaN where the start is at or below ū∞; the Barus engine's status
+    (``st_ok`` / ``st_below``) into ``status``."""
     n = u_start.size
     for b in prange((n + 255) // 256):
-        _g_start_rows(bt, aE, p0, E, u_start, h, y_default, code, st_ok, st_below, gs, status,
-                      b * 256, min(b * 256 + 256, n))
+        _g_start_rows(bt, aE, p0, E, u_start, h, y_default, gx, code, st_ok, st_below, gs,
+                      status, b * 256, min(b * 256 + 256, n))
 
 
 @njit(cache=True)
-def _g_start_rows(bt, aE, p0, E, u_start, h, y_default, code, st_ok, st_below, gs, status, b0,
-                  b1):
+def _g_start_rows(bt, aE, p0, E, u_start, h, y_default, gx, code, st_ok, st_below, gs, status,
+                  b0, b1):
     sp = 1 if p0.size > 1 else 0
     sE = 1 if E.size > 1 else 0
+    m = gx.size - 2
     for i in range(b0, b1):
         if code[i] == qk.ST_BELOW:
             gs[i] = math.nan
             status[i] = st_below
             continue
         status[i] = st_ok
-        x0 = math.log(p0[i * sp] / E[i * sE])
+        r = p0[i * sp] / E[i * sE]
+        x0 = math.log(r)
+        if y_default >= 0.0 and m >= 4:
+            u = (x0 - gx[0]) / gx[1]
+            k = int(u) - 1
+            if k < 0:
+                k = 0
+            if k > m - 4:
+                k = m - 4
+            t = u - k
+            a0, a1, a2, a3 = t, t - 1.0, t - 2.0, t - 3.0
+            gs[i] = (-a1 * a2 * a3 / 6.0 * gx[2 + k] + a0 * a2 * a3 / 2.0 * gx[3 + k]
+                     - a0 * a1 * a3 / 2.0 * gx[4 + k] + a0 * a1 * a2 / 6.0 * gx[5 + k])
+            continue
         y = y_default
         if y < 0.0:
             vs = u_start[i] / h
             y = 0.0
             if vs < bt.v_ext:
                 y = math.exp(s_cell(bt, math.log(vs))[5] - x0)
-        gs[i] = _rate_factor(aE * (p0[i * sp] / E[i * sE]) * (1.0 - y))
+        gs[i] = _rate_factor(aE * r * (1.0 - y))
+
+
+#: nodes per unit of ln(p0/E*) of :func:`default_rate_table`: the cubic Lagrange error is
+#: ~h⁴/40 times g's fourth derivative in ln p0, which is O(1) for α p0 <= 0.6 (~1e-12)
+RATE_TABLE_DENSITY = 512
+
+
+def default_rate_table(bg, y):
+    """(x_first, dx, g at x_first + k dx, k = 0...) for :func:`_g_start_kernel`: the rate
+    factor at the default start g(α E* e^x (1 - y)) on a uniform grid over the x0 = ln(p0/E*)
+    the G primitive ``bg`` serves (one ``_rate_factor`` per row was as long as the kernel's
+    whole default-start case); kept on ``bg``."""
+    key = float(y)
+    hit = bg.rate_tables.get(key)
+    if hit is not None:
+        return hit
+    lo, hi = float(bg.pr.xn[0]) - 0.01, bg.x_served + 0.01
+    m = max(8, int(math.ceil((hi - lo) * RATE_TABLE_DENSITY)) + 1)
+    x = np.linspace(lo, hi, m)
+    g = np.empty(m)
+    _rate_factor_array(bg.aE * np.exp(x) * (1.0 - y), g)
+    out = readonly(np.concatenate(([lo, (hi - lo) / (m - 1)], g)))
+    bg.rate_tables[key] = out
+    return out
