@@ -222,3 +222,30 @@ def test_one_fluid_squeeze_out_against_quadrature_random(tables, theory):
     t_ref = squeeze_time(tables, theory, p0[i], E_STAR, R, ETA, alpha, r.u_start, r[names[k]],
                          r.u_inf, rtol=1e-10)
     assert abs(t_ref / times[k] - 1) < 1e-6
+
+
+def test_one_fluid_bounds_of_the_physics(tables):
+    """2,000 random footprints of one fluid served by the G primitive: every time lies between
+    the constant-viscosity time and twice it (the rate factor g ∈ (1/2, 1]; it only slows the
+    squeeze-out, at most by half), ū at the exit between the base engine's and ū(0), ū∞ the
+    base engine's (viscosity-free) — bounds of the physics, no reference needed."""
+    rng = np.random.default_rng(6)
+    n = 2000
+    alpha = 1.5e-6
+    p0 = np.exp(rng.uniform(math.log(2e3), math.log(0.4 / alpha), n))  # α p0 <= 0.4
+    kw = dict(p0=p0, E_star=E_STAR, R=R, eta=ETA, footprint_length=0.1,
+              speed=10 ** rng.uniform(-2, 1.5, n), theory="emt",
+              u_start=10 ** rng.uniform(-5, -2, n), method="fast")
+    _bg, idx, _rest = _served(tables, "emt", p0, alpha, kw["u_start"])
+    assert idx.size > 0.9 * n
+    g = tire_footprint(tables, alpha_pv=alpha, **kw)
+    b = tire_footprint(tables, **kw)
+    ok = (g.status == "ok").to_numpy()
+    assert ok.sum() > 1500 and list(g.status) == list(b.status)
+    np.testing.assert_array_equal(g.u_inf[ok], b.u_inf[ok])
+    for c in ("t_star", "t_ratio_1.1", "t_ratio_1.01", "t_du"):
+        tg, tb = g[c][ok].to_numpy(), b[c][ok].to_numpy()
+        pos = tb > 0
+        assert np.all(tg[pos] >= tb[pos] * (1 - 1e-9)) and np.all(tg[pos] <= 2 * tb[pos]), c
+    ue, ub, u0 = (x[ok].to_numpy() for x in (g.u_exit, b.u_exit, g.u_start))
+    assert np.all(ue >= ub * (1 - 1e-12)) and np.all(ue <= u0)
