@@ -94,12 +94,13 @@ def warm_group(group):
         import numpy as np
         from .squeeze import squeeze_out
         for method in ("fast", "quad"):
-            for alpha in (1e-7, np.array([1e-7, 2e-7])):  # one fluid (the Barus time
-                # primitive on the base kernels) and α per case (the per-case Barus kernels)
+            # one fluid (the Barus time primitive on the base kernels) and α per case (the
+            # per-case Barus kernels)
+            for alpha in (1e-7, np.array([1e-7, 2e-7])):
                 squeeze_out(T, p0=np.array([1e5, 2e5]), E_star=_E_STAR, R=_R, eta=_ETA,
                             theory="emt", method=method, alpha_pv=alpha)
-                _tire(T, "emt", method,
-                      alpha_pv=alpha if np.ndim(alpha) == 0 else np.array([1e-7, 2e-7, 1e-7]))
+            for alpha in (1e-7, np.array([1e-7, 2e-7, 1e-7])):
+                _tire(T, "emt", method, alpha_pv=alpha)
         _seal(T, alpha_pv=2e-7)
         _seal(T, viscosity="roelands", alpha_pv=2e-7, roelands_z=0.6, roelands_p_r=1.96e8)
     return time.perf_counter() - t0
@@ -135,7 +136,7 @@ def warm(groups=None, jobs=1, log=None):
     while pending or running:
         while pending and len(running) < jobs:
             g = pending.pop(0)
-            cmd = [sys.executable, "-c", f"from fastcontact.warm import warm_group\n"
+            cmd = [sys.executable, "-c", "from fastcontact.warm import warm_group\n"
                    f"warm_group({g!r})"]
             # stderr to a file, not a pipe: a pipe read only at the end blocks a chatty child
             err = tempfile.TemporaryFile(mode="w+")

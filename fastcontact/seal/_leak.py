@@ -21,13 +21,14 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
+from ..kernels._index import INT0
 from ._lookup import _sig_fast
 from ._primitive import (P_OK, P_T, _adaptive, _asym, _gl_s, _left, _right, _split, _whole,
                          asym_primitive)
 
-#: the order 0 ("the rule in G") as an argument of a jitted helper: a literal int would compile
-#: the helper once per value (numba specialises on literal ints); a NumPy int64 is typed int64
-_I0 = np.int64(0)
+#: the order 0 ("the rule in G") as an int64 (a literal would compile the helper once more:
+#: :data:`fastcontact.kernels._index.INT0`)
+_I0 = INT0
 
 __all__ = ["leak_integral", "uniform_rows", "RingRows", "RingOut", "invert_uniform", "ST_OK",
            "ST_LIFT_OFF", "ST_OPEN", "ST_PERCOLATED", "ST_ABOVE_TABLE", "ST_NOT_CONVERGED",

@@ -40,6 +40,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from ..kernels._index import INT0, INT1
 from ._mesh import (array_zone, geometry, interp_series, panel_series, remaining_fraction,
                     solve_small, zone_params)
 from ._panel_records import Mesh, State, Work, Zone, _work
@@ -52,10 +53,8 @@ __all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "solve_rows_
 
 #: status codes of solve_case
 ST_OK, ST_NOT_REFINED, ST_NEWTON_FAILED, ST_NO_ZONE = 0, 1, 2, 3
-#: the integers 0 and 1 as arguments of jitted helpers: numba compiles a helper once per
-#: literal int it is called with (``f(0, ...)`` and ``f(1, ...)`` are two compiles of several
-#: seconds each, a third for a variable); a NumPy integer is typed int64, as a variable is
-_I0, _I1 = np.int64(0), np.int64(1)
+#: int64 0 and 1 for jitted helpers' int arguments (:data:`fastcontact.kernels._index.INT0`)
+_I0, _I1 = INT0, INT1
 
 
 @njit(cache=True, inline="always")

@@ -17,8 +17,7 @@ import numpy as np
 from . import _hertz, _panels
 from .context import RowsOut, panel_rule, solver_options
 
-__all__ = ["HertzTable", "hertz_table", "table_W", "table_cost", "H1", "NY", "TABLE_TOL",
-           "VERIFY_TOL"]
+__all__ = ["HertzTable", "hertz_table", "table_W", "H1", "NY", "TABLE_TOL", "VERIFY_TOL"]
 
 #: grid spacing in ln π_H, number of y intervals
 H1 = 0.05
@@ -53,13 +52,9 @@ class HertzTable(NamedTuple):
 _LOCK = threading.Lock()
 
 
-#: Barus fluids (α̃ = α E* > 0) whose O-ring tables a SealContext keeps (the last asked)
+#: fluids (Barus α̃ = α E* > 0, or a Roelands law) whose O-ring tables a SealContext keeps
+#: (the last asked)
 PIEZO_TABLES = 4
-
-
-def _fluid_key(al, vis):
-    """The key of a fluid's table: 0.0 (constant viscosity), α̃ (Barus) or the Roelands law."""
-    return float(al) if vis is None else tuple(float(x) for x in vis)
 
 
 def hertz_table(sc, al=0.0, vis=None):
@@ -68,26 +63,27 @@ def hertz_table(sc, al=0.0, vis=None):
     one E*, W is again a function of (π_H, π_a) alone); ``vis`` = (A, Z, π_r): a Roelands
     fluid's (the law of :mod:`fastcontact.flow.piezoviscosity`, π_r = p_r/E*); kept for the
     last PIEZO_TABLES fluids."""
-    al = _fluid_key(al, vis)
+    key = float(al) if vis is None else tuple(float(x) for x in vis)
     with _LOCK:
-        if al == 0.0 and sc.hertz is not None:
+        if key == 0.0:
+            if sc.hertz is None:
+                sc.hertz = _empty_table(sc)
             return sc.hertz
         memo = sc.hertz_piezo
-        if al != 0.0:
-            if al in memo:
-                memo[al] = memo.pop(al)  # most recent last
-                return memo[al]
-        t0 = sc.rec.t_lo - 3.0
-        K = int(math.ceil((math.log(sc.p_top) - t0) / H1)) + 1
-        ht = HertzTable(t0, H1, np.full((K, NY + 1), np.nan), np.zeros((K, NY), dtype=np.int8),
-                        np.zeros(K, dtype=np.bool_))
-        if al == 0.0:
-            sc.hertz = ht
+        if key in memo:
+            memo[key] = memo.pop(key)  # most recent last
         else:
-            memo[al] = ht
+            memo[key] = _empty_table(sc)
             while len(memo) > PIEZO_TABLES:
                 memo.pop(next(iter(memo)))
-        return ht
+        return memo[key]
+
+
+def _empty_table(sc):
+    t0 = sc.rec.t_lo - 3.0
+    K = int(math.ceil((math.log(sc.p_top) - t0) / H1)) + 1
+    return HertzTable(t0, H1, np.full((K, NY + 1), np.nan), np.zeros((K, NY), dtype=np.int8),
+                      np.zeros(K, dtype=np.bool_))
 
 
 def _solve_W(sc, piH, pia, equal, al=0.0, vis=None):
@@ -138,10 +134,12 @@ def _verify_cells(sc, ht, kc, jc, al=0.0, vis=None):
     ht.cell[kc, jc] = np.where(good, 1, 2)
 
 
-def table_W(sc, piH, pia, rows, al=0.0, vis=None):
+def table_W(sc, piH, pia, rows, al=0.0, vis=None, max_solves=None):
     """W [-] of the rows (p_b = 0) from the table (of the Barus fluid α̃ = ``al`` > 0, or the
     Roelands law ``vis`` = (A, Z, π_r), one for every row); NaN where the solver must be
-    used."""
+    used. ``max_solves``: None (and no table read) where completing the table for these rows
+    — its grid rows still to build (NY + 1 solves each) and cells still to verify (one each) —
+    would take more solver calls than that (e.g. than solving the rows themselves)."""
     ht = hertz_table(sc, al, vis)
     K = ht.lw.shape[0]
     t = np.log(piH[rows])
@@ -156,30 +154,16 @@ def table_W(sc, piH, pia, rows, al=0.0, vis=None):
         todo = ht.cell[kc, jc] == 0
         if todo.any():
             need = np.unique((kc[todo][:, None] + np.arange(-2, 4)[None, :]).ravel())
-            _build_rows(sc, ht, need[(need >= 0) & (need < K)], al, vis)
+            need = need[(need >= 0) & (need < K)]
+            if (max_solves is not None
+                    and int((~ht.built[need]).sum()) * (NY + 1) + int(todo.sum()) > max_solves):
+                return None
+            _build_rows(sc, ht, need, al, vis)
             _verify_cells(sc, ht, kc[todo], jc[todo], al, vis)
     lnW = np.full(piH.size, np.nan)
     sel = rows[inside]
     _hertz.hertz_interp(ht, piH, pia, np.ascontiguousarray(sel, dtype=np.int64), False, lnW)
     return np.exp(lnW)
-
-
-def table_cost(sc, piH, pia, rows, al=0.0, vis=None):
-    """Solver calls that :func:`table_W` of these rows would make before it can answer: the
-    grid rows it still has to build (NY + 1 nodes each, with the stencil's neighbours) and the
-    cells it still has to verify (one each) — to compare with solving the rows themselves."""
-    ht = hertz_table(sc, al, vis)
-    K = ht.lw.shape[0]
-    t = np.log(piH[rows])
-    k = np.floor((t - ht.t0) / ht.h1).astype(np.int64)
-    j = np.clip((_y_vec(piH[rows], pia[rows]) * NY).astype(np.int64), 0, NY - 1)
-    inside = (k >= 2) & (k <= K - 4)
-    cells = np.unique(k[inside] * NY + j[inside])
-    kc, jc = cells // NY, cells % NY
-    todo = ht.cell[kc, jc] == 0
-    need = np.unique((kc[todo][:, None] + np.arange(-2, 4)[None, :]).ravel())
-    need = need[(need >= 0) & (need < K)]
-    return int((~ht.built[need]).sum()) * (NY + 1) + int(todo.sum())
 
 
 def _y_vec(piH, pia):

@@ -650,81 +650,68 @@ def _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha):
 
 
 def _barus_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, alpha):
-    """:func:`_barus_hertz_k`, with the rows of one Barus fluid on one rubber (one α̃ = α E*,
-    p_b = 0, below lift-off) from the fluid's verified O-ring table
-    (:func:`fastcontact.seal.hertz.table_W`; ~1e-7 in W as the base O-ring's); the others,
-    and the rows whose cells are not verified, by the solver."""
+    """:func:`_barus_hertz_k`, the rows of one Barus fluid on one rubber (one α̃ = α E*) from
+    the fluid's verified O-ring table where it pays (:func:`_hertz_k_tabled`)."""
     al = alpha * E
-    n = E.size
-    if n < TABLE_MIN_ROWS or not (al.min() == al.max() and al[0] > 0.0):
-        return _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha)
-    from .hertz import table_W
-    sc = seal_context(tables, theory)
-    piH = np.ascontiguousarray(pH / E)
-    pia = np.ascontiguousarray(pa / E)
-    rows = np.flatnonzero((pb == 0.0) & (pa < pH))
-    if not _table_pays(sc, piH, pia, rows, float(al[0]), None):
-        return _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha)
-    W = table_W(sc, piH, pia, rows, float(al[0]))
-    fast = np.isfinite(W)
-    k = np.empty(n)
-    ok = np.ones(n, dtype=bool)
-    dp = pa - pb
+    args = (E, pH, a, pa, pb, alpha)
+    if E.size < TABLE_MIN_ROWS or not (al.min() == al.max() and al[0] > 0.0):
+        return _barus_hertz_k(tables, theory, *args)
     with np.errstate(divide="ignore", invalid="ignore"):
-        k[fast] = -np.expm1(-alpha[fast] * dp[fast]) / alpha[fast] / (a[fast] * W[fast])
-    rest = np.flatnonzero(~fast)
-    if rest.size:
-        k[rest], ok[rest] = _barus_hertz_k(tables, theory, *(x[rest] for x in
-                                                             (E, pH, a, pa, pb, alpha)))
-    return k, ok
+        psia = -np.expm1(-alpha * (pa - pb)) / alpha  # [Pa], α > 0 here
+    return _hertz_k_tabled(tables, theory, E, pH, a, pa, pb, float(al[0]), None,
+                           lambda i: psia[i],
+                           lambda i: _barus_hertz_k(tables, theory, *(x[i] for x in args)))
 
 
 def _roelands_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, A, Z, pr):
-    """:func:`_roelands_hertz_k`, with the rows of one Roelands fluid on one rubber (one law
-    (A, Z, p_r/E*), p_b = 0, below lift-off) from the fluid's verified O-ring table, as
-    :func:`_barus_hertz_k_tabled`."""
+    """:func:`_roelands_hertz_k`, the rows of one Roelands fluid on one rubber (one law
+    (A, Z, p_r/E*)) from the fluid's verified O-ring table where it pays
+    (:func:`_hertz_k_tabled`)."""
     n = E.size
     pr = np.broadcast_to(np.asarray(pr, dtype=np.float64), (n,))  # p_r: one or per row
     prn = pr / E
+    args = (E, pH, a, pa, pb, A, Z, pr)
     if n < TABLE_MIN_ROWS or not all(x.min() == x.max() for x in (A, Z, prn)):
-        return _roelands_hertz_k(tables, theory, E, pH, a, pa, pb, A, Z, pr)
+        return _roelands_hertz_k(tables, theory, *args)
+
+    def psia(i):  # E* ψ_a [Pa] from the law's tabulated ψ
+        out = np.empty(i.size)
+        psi_drops(*(np.ascontiguousarray(x[i], dtype=np.float64) for x in
+                    (A, Z, prn, (pa - pb) / E)), out)
+        return E[i] * out
+    return _hertz_k_tabled(tables, theory, E, pH, a, pa, pb, 0.0, (A[0], Z[0], prn[0]), psia,
+                           lambda i: _roelands_hertz_k(tables, theory, *(x[i] for x in args)))
+
+
+def _hertz_k_tabled(tables, theory, E, pH, a, pa, pb, al, vis, psia, solve):
+    """(k [Pa/m], converged) of O-rings of one fluid (Barus α̃ = ``al``, or the Roelands law
+    ``vis``): the rows with p_b = 0 below lift-off from the fluid's verified O-ring table
+    (:func:`fastcontact.seal.hertz.table_W`; ~1e-8 in Q of the solver), k = ψ_a/(a W),
+    ``psia(i)`` the rows' ψ_a [Pa]; where completing the table for them would take more solves
+    than the rows themselves (a few hundred O-rings of scattered p_H; not a Δp sweep of a few
+    O-rings, a large study, or rows a kept table covers) every row, and the rows whose cells
+    are not verified, by ``solve(i)`` -> (k, converged)."""
     from .hertz import table_W
-    sc = seal_context(tables, theory)
-    piH = np.ascontiguousarray(pH / E)
-    pia = np.ascontiguousarray(pa / E)
+    n = E.size
     rows = np.flatnonzero((pb == 0.0) & (pa < pH))
-    law = (A[0], Z[0], prn[0])
-    if not _table_pays(sc, piH, pia, rows, 0.0, law):
-        return _roelands_hertz_k(tables, theory, E, pH, a, pa, pb, A, Z, pr)
-    W = table_W(sc, piH, pia, rows, vis=law)
+    W = None if rows.size == 0 else table_W(
+        seal_context(tables, theory), np.ascontiguousarray(pH / E), np.ascontiguousarray(pa / E),
+        rows, al, vis, max_solves=rows.size)
+    if W is None:
+        return solve(np.arange(n))
     fast = np.flatnonzero(np.isfinite(W))
+    rest = np.flatnonzero(~np.isfinite(W))
     k = np.empty(n)
     ok = np.ones(n, dtype=bool)
-    if fast.size:
-        psia = np.empty(fast.size)
-        psi_drops(*(np.ascontiguousarray(x[fast], dtype=np.float64) for x in
-                    (A, Z, prn, (pa - pb) / E)), psia)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k[fast] = E[fast] * psia / (a[fast] * W[fast])
-    rest = np.flatnonzero(~np.isfinite(W))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k[fast] = psia(fast) / (a[fast] * W[fast])
     if rest.size:
-        k[rest], ok[rest] = _roelands_hertz_k(tables, theory, *(x[rest] for x in
-                                                                (E, pH, a, pa, pb, A, Z, pr)))
+        k[rest], ok[rest] = solve(rest)
     return k, ok
 
 
-def _table_pays(sc, piH, pia, rows, al, vis):
-    """Whether reading the fluid's O-ring table costs fewer solver calls than solving the
-    rows: the table's grid rows and cells still to build and verify (a spread of contact
-    pressures needs many; a Δp sweep of a few O-rings few; a kept table none) against the
-    rows themselves."""
-    from .hertz import table_cost
-    return table_cost(sc, piH, pia, rows, al, vis) <= rows.size
-
-
-#: fewest O-ring rows of one fluid (Barus or Roelands) for which :func:`_barus_hertz_k_tabled`
-#: and :func:`_roelands_hertz_k_tabled` consider the fluid's table (used where it pays,
-#: :func:`_table_pays`) instead of solving each row (~70-100 µs a row)
+#: fewest O-ring rows of one fluid (Barus or Roelands) for which :func:`_hertz_k_tabled` is
+#: tried (the table used where it pays) instead of solving each row (~70-100 µs a row)
 TABLE_MIN_ROWS = 500
 
 

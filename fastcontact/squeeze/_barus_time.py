@@ -42,6 +42,7 @@ from numba import njit, prange
 from ..kernels.readonly import readonly, readonly_fields
 from . import _kernels as qk
 from ._barus_primitive import API_FAST, K_MAX, s_at, s_cell, series_order, shift
+from ._fastpath import fast_kernel, row_targets
 from ._primitive_eval import Primitive, _index_map, _locate, lagrange_denominators
 from .viscosity import _rate_factor, _rate_factor_array
 
@@ -73,12 +74,24 @@ _LOCK = Lock()
 _MEMO_SIZE = 4
 
 
-def barus_time(model, pr, bt, c, x_fast, aE, z_need):
+def barus_time(model, pr, bt, c, x_fast, aE, v_max):
     """The :class:`BarusTime` of ``model`` (its primitive ``pr``, Barus table ``bt``, series
-    coefficients ``c``, fast limit ``x_fast``) for α E* = ``aE`` [-], its z grid reaching
-    ``z_need`` (grid variable ζ = z + ln κ); None where fewer than four rows have A <=
-    API_FAST. Kept for the last few (model, α E*) asked (a sweep of one fluid builds it once;
-    a taller grid asked later is built again)."""
+    coefficients ``c``, fast limit ``x_fast``) for α E* = ``aE`` [-], its z grid reaching the
+    start v = ū(0)/h_rms = ``v_max`` on every row (0: the base grid); None where fewer than
+    four rows have A <= API_FAST. Kept for the last few (model, α E*) asked (a sweep of one
+    fluid builds it once; a taller grid asked later is built again)."""
+    x_lim = math.log(API_FAST / aE)
+    xn = pr.xn
+    j_lim = int(np.searchsorted(xn, x_lim, side="right"))  # rows with A <= API_FAST
+    rows = min(xn.size, j_lim + 3)
+    while rows > 0 and aE * math.exp(xn[rows - 1]) > A_ROW_MAX:
+        rows -= 1
+    if rows < 4 or j_lim < 1:
+        return None
+    z_need = pr.z0 + (pr.nz - 1) * pr.dz
+    vinf_min = math.exp(float(np.min(pr.lnv[:rows])))
+    if v_max > vinf_min:  # the highest start on the row of the smallest ū∞ and largest κ
+        z_need = max(z_need, math.log(v_max / vinf_min - 1.0) + float(np.max(pr.lk[:rows])))
     key = (model.key(), float(aE))
     with _LOCK:
         hit = _MEMO.get(key)
@@ -88,14 +101,6 @@ def barus_time(model, pr, bt, c, x_fast, aE, z_need):
     nz = pr.nz
     if z_need > pr.z0 + (nz - 1) * pr.dz:
         nz = int(math.ceil((z_need - pr.z0) / pr.dz)) + 2
-    x_lim = math.log(API_FAST / aE)
-    xn = pr.xn
-    j_lim = int(np.searchsorted(xn, x_lim, side="right"))  # rows with A <= API_FAST
-    rows = min(xn.size, j_lim + 3)
-    while rows > 0 and aE * math.exp(xn[rows - 1]) > A_ROW_MAX:
-        rows -= 1
-    if rows < 4 or j_lim < 1:
-        return None
     xg = np.ascontiguousarray(xn[:rows])
     C = np.empty((rows, nz, 3))
     _build_kernel(pr, bt, c, float(aE), nz, C)
@@ -202,22 +207,35 @@ def served_rows(model, setup, p, E, alpha, us_in, h):
     pr, bt, c, x_fast = setup
     aE = float(alpha[0] * E[0])
     x0 = np.log(p / E)
-    x_hi = min(x_fast, math.log(API_FAST / aE))
-    ok = (x0 >= model.mp.x_min) & (x0 <= x_hi) & ~(us_in == math.inf)
+    ok = ((x0 >= model.mp.x_min) & (x0 <= min(x_fast, math.log(API_FAST / aE)))
+          & ~(us_in == math.inf))
     if not ok.any():
         return None, every[:0], every
     v_s = us_in[ok] / h
-    v_max = float(np.max(v_s[np.isfinite(v_s)], initial=0.0))
-    rows = int(np.searchsorted(pr.xn, x_hi, side="right")) + 3
-    vinf_min = math.exp(float(np.min(pr.lnv[:rows])))
-    z_need = pr.z0 + (pr.nz - 1) * pr.dz
-    if v_max > vinf_min:
-        z_need = max(z_need, math.log(v_max / vinf_min - 1.0) + float(np.max(pr.lk[:rows])))
-    bg = barus_time(model, pr, bt, c, x_fast, aE, z_need)
+    bg = barus_time(model, pr, bt, c, x_fast, aE,
+                    float(np.max(v_s[np.isfinite(v_s)], initial=0.0)))
     if bg is None:
         return None, every[:0], every
     ok &= x0 <= bg.x_served
     return bg, every[ok], every[~ok]
+
+
+def _base_inputs(bg, cs, idx, every, ratios, dvs, times2d, h):
+    """(cases, targets, row targets) of the base fast kernel for the rows ``idx`` of ``cs``
+    (``every``: all rows, no copy), ratio targets ``ratios`` (without t_star's), Δu targets
+    ``dvs`` [-] and times ``times2d`` [s] (rows × (1 or the rows))."""
+    def sub(a):
+        return a if a.size == 1 or every else readonly(np.ascontiguousarray(a[idx]))
+
+    csg = qk.Cases(*(sub(a) for a in cs))
+    if times2d.shape[1] > 1:  # one time per case: the served rows'
+        times2d = readonly(sub(times2d[0]).reshape(1, -1))
+    tg = readonly_fields(qk.Targets(np.ascontiguousarray(ratios, dtype=np.float64),
+                                    np.ascontiguousarray(dvs, dtype=np.float64),
+                                    np.ascontiguousarray(times2d)))
+    us = csg.us
+    shared = idx.size > 1 and (us.size == 1 or us.min() == us.max())
+    return csg, tg, row_targets(bg.pr, tg.ratios, tg.dvs, us[0] / h if shared else math.nan)
 
 
 def tire_rows(model, bg, cs, t_fp, h, ratios, dvs, quad, res, idx):
@@ -225,21 +243,10 @@ def tire_rows(model, bg, cs, t_fp, h, ratios, dvs, quad, res, idx):
     times t_fp [s], size 0: no exit asked) by the base engine's fast kernel on the G primitive
     ``bg`` (:class:`BarusTime`), into ``res`` (:data:`~.tire_piezo.TireOut`): targets t_star,
     the ratios, Δu = dvs h_rms [m] (reduced ``dvs``), ū at the footprint exit."""
-    from ._fastpath import fast_kernel, row_targets
-
     ng = idx.size
     every = ng == res.u_inf.size  # every row: the kernel writes into res itself
-
-    def sub(a):
-        return a if a.size == 1 or every else readonly(np.ascontiguousarray(a[idx]))
-
-    csg = qk.Cases(*(sub(a) for a in cs))
-    times2d = (readonly(sub(t_fp).reshape(1, -1)) if t_fp.size else np.empty((0, 1)))
-    tg = readonly_fields(qk.Targets(np.ascontiguousarray(ratios, dtype=np.float64),
-                                    np.ascontiguousarray(dvs, dtype=np.float64), times2d))
-    us = csg.us
-    shared = ng > 1 and (us.size == 1 or us.min() == us.max())
-    rt = row_targets(bg.pr, tg.ratios, tg.dvs, us[0] / h if shared else math.nan)
+    csg, tg, rt = _base_inputs(bg, cs, idx, every, ratios, dvs,
+                               t_fp.reshape(1, -1) if t_fp.size else np.empty((0, 1)), h)
     if every:  # status codes: the base engine's names come first in the Barus tire's
         U = res.u_exit.reshape(1, -1) if t_fp.size else np.empty((0, ng))
         out = qk.SqOut(res.T, U, res.u_inf, res.u_start, np.empty(ng), res.u_trap,
@@ -248,7 +255,7 @@ def tire_rows(model, bg, cs, t_fp, h, ratios, dvs, quad, res, idx):
         if not t_fp.size:
             res.u_exit[:] = math.nan
         return
-    out = qk.SqOut(np.empty((res.T.shape[0], ng)), np.empty((times2d.shape[0], ng)),
+    out = qk.SqOut(np.empty((res.T.shape[0], ng)), np.empty((tg.times.shape[0], ng)),
                    *(np.empty(ng) for _ in range(7)), np.empty(ng, dtype=np.int8))
     fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, csg, h, tg, quad, out, False)
     res.T[:, idx] = out.T
@@ -260,6 +267,16 @@ def tire_rows(model, bg, cs, t_fp, h, ratios, dvs, quad, res, idx):
     res.status[idx] = out.status
 
 
+def run_rest(out, rest, run):
+    """``run(sub, part)`` on the rows ``rest`` of the record ``out`` (arrays with the rows on
+    their last axis) as a call of its own — ``sub(a)`` the rows' read-only copy of a case
+    array, ``part`` a fresh record of ``out``'s shape for them — and its part written back."""
+    part = type(out)(*(np.empty(a.shape[:-1] + (rest.size,), a.dtype) for a in out))
+    run(lambda a: readonly(np.ascontiguousarray(a[rest])), part)
+    for a, b in zip(out, part):
+        a[..., rest] = b
+
+
 def squeeze_rows(model, bg, cs, tg, h, quad, out, idx):
     """The Barus squeeze-out rows ``idx`` of the cases ``cs`` by the base engine's fast kernel
     on the G primitive ``bg``, into ``out`` (:data:`~.viscosity.BarusOut`; ``tg`` its
@@ -267,22 +284,14 @@ def squeeze_rows(model, bg, cs, tg, h, quad, out, idx):
     ū∞, ū(0), τ0, the rate factor g at the start and the status. Returns the indices (into
     ``idx``'s rows) the base kernel flagged "overflow" (τ0 or a time not representable),
     which the Barus engine has no status for: the caller runs them by its per-case kernel."""
-    from ._fastpath import fast_kernel, row_targets
     from .model import DEFAULT_P_START
     from .viscosity import ST_BELOW, ST_OK
 
     ng = idx.size
     every = ng == out.u_inf.size  # every row: the kernel writes into out itself
-
-    def sub(a):
-        return a if a.size == 1 or every else readonly(np.ascontiguousarray(a[idx]))
-
-    csg = qk.Cases(*(sub(a) for a in cs))
-    times2d = np.ascontiguousarray(tg.times[:, None])
-    tgb = readonly_fields(qk.Targets(np.ascontiguousarray(tg.ratios[1:]), tg.dvs, times2d))
+    csg, tgb, rt = _base_inputs(bg, cs, idx, every, tg.ratios[1:], tg.dvs, tg.times[:, None], h)
     us = csg.us
-    shared = ng > 1 and (us.size == 1 or us.min() == us.max())
-    rt = row_targets(bg.pr, tgb.ratios, tgb.dvs, us[0] / h if shared else math.nan)
+    times2d = tgb.times
     code = np.empty(ng, dtype=np.int8)
     if every:
         o = qk.SqOut(out.T, out.U, out.u_inf, out.u_start, np.empty(ng), np.empty(ng),

@@ -107,32 +107,22 @@ def _fast_rows(tables, theory, tab, sc, cs, al, tf, h, tg, quad, res):
     :mod:`._barus_time`, the base engine's kernel) and the others by the Barus kernel
     (:func:`._barus_fast.tire_kernel`), into ``res``."""
     from ._barus_fast import ratio_rows, tire_kernel
-    from ._barus_time import served_rows, tire_rows
+    from ._barus_time import run_rest, served_rows, tire_rows
     from .model import squeeze_model
     setup = fast_setup(tables, theory, None)
     model = squeeze_model(tables, theory)
     bg, gi, rest = served_rows(model, setup, cs.p0, cs.E, al, cs.us, h)
     if gi.size:
         tire_rows(model, bg, cs, tf, h, tg.ratios[1:], tg.dvs, quad, res, gi)
-    if rest.size == 0:
-        return
-    if gi.size:  # the others as a call of their own
-        def sub(a):
-            return readonly(np.ascontiguousarray(a[rest]))
-        cs_r = Cases(*(sub(a) for a in cs))
-        T_r = np.empty((res.T.shape[0], rest.size))
-        part = TireOut(T_r, *(np.empty(rest.size) for _ in range(5)),
-                       np.empty(rest.size, dtype=np.int8))
-        tire_kernel(tab, sc, *setup, cs_r, sub(al), sub(tf) if tf.size else tf, h, tg,
-                    *ratio_rows(*setup[:3], tg), quad, part, fast_scratch())
-        for name in TireOut._fields:
-            if name == "T":
-                res.T[:, rest] = part.T
-            else:
-                getattr(res, name)[rest] = getattr(part, name)
-        return
-    tire_kernel(tab, sc, *setup, cs, al, tf, h, tg, *ratio_rows(*setup[:3], tg), quad, res,
-                fast_scratch())
+
+    def per_case(sub, part):
+        tire_kernel(tab, sc, *setup, Cases(*(sub(a) for a in cs)), sub(al),
+                    sub(tf) if tf.size else tf, h, tg, *ratio_rows(*setup[:3], tg), quad, part,
+                    fast_scratch())
+    if rest.size == cs.p0.size:
+        per_case(lambda a: a, res)
+    elif rest.size:  # the others as a call of their own
+        run_rest(res, rest, per_case)
 
 
 def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_complete,

@@ -499,37 +499,25 @@ def _fast_rows(tables, theory, sigma_trap, sc, cs, al, h, tg, quad, out):
     (:func:`._barus_fast.squeeze_kernel`), into ``out`` (:data:`BarusOut`). Returns the
     primitive's provenance (None where it served no row)."""
     from ._barus_fast import ratio_rows, squeeze_kernel
-    from ._barus_time import served_rows, squeeze_rows
+    from ._barus_time import run_rest, served_rows, squeeze_rows
     setup = fast_setup(tables, theory, sigma_trap)
-    tab = tables.kernel_data(theory)
-    bg, gi, rest = served_rows(squeeze_model(tables, theory, sigma_trap), setup, cs.p0, cs.E,
-                               al, cs.us, h)
+    model = squeeze_model(tables, theory, sigma_trap)
+    bg, gi, rest = served_rows(model, setup, cs.p0, cs.E, al, cs.us, h)
     if gi.size:
-        over = squeeze_rows(squeeze_model(tables, theory, sigma_trap), bg, cs, tg, h, quad,
-                            out, gi)
+        over = squeeze_rows(model, bg, cs, tg, h, quad, out, gi)
         if over.size:
             rest = np.sort(np.concatenate((rest, gi[over])))
     info = None if bg is None or rest.size == cs.p0.size else {
         "alpha_E_star": bg.aE, "rows": int(bg.pr.xn.size), "z_nodes": int(bg.pr.nz),
         "max_ln_p0_over_E_star": bg.x_served, "cases_served": int(cs.p0.size - rest.size)}
-    if rest.size == 0:
-        return info
-    if rest.size == cs.p0.size:
-        squeeze_kernel(tab, sc, *setup, cs, al, h, tg, *ratio_rows(*setup[:3], tg), quad, out,
-                       fast_scratch())
-        return info
 
-    def sub(a):  # the other rows as a call of their own
-        return readonly(np.ascontiguousarray(a[rest]))
-    part = BarusOut(np.empty((out.T.shape[0], rest.size)), np.empty((out.U.shape[0], rest.size)),
-                    *(np.empty(rest.size) for _ in range(4)), np.empty(rest.size, dtype=np.int8))
-    squeeze_kernel(tab, sc, *setup, Cases(*(sub(a) for a in cs)), sub(al), h, tg,
-                   *ratio_rows(*setup[:3], tg), quad, part, fast_scratch())
-    for name in BarusOut._fields:
-        if name in ("T", "U"):
-            getattr(out, name)[:, rest] = getattr(part, name)
-        else:
-            getattr(out, name)[rest] = getattr(part, name)
+    def per_case(sub, part):
+        squeeze_kernel(tables.kernel_data(theory), sc, *setup, Cases(*(sub(a) for a in cs)),
+                       sub(al), h, tg, *ratio_rows(*setup[:3], tg), quad, part, fast_scratch())
+    if rest.size == cs.p0.size:
+        per_case(lambda a: a, out)
+    elif rest.size:  # the others as a call of their own
+        run_rest(out, rest, per_case)
     return info
 
 
