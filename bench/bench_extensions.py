@@ -134,7 +134,8 @@ def bench_squeeze(lines, tables, quick, summary):
                                           alpha_pv=1e-6, theory="emt"), 3)
     lines.append(f"| fast | – | – | {max(ef.values()):.1e} (α p0 = 0.3: {ef[0.3]:.1e}, 0.6: "
                  f"{ef[0.6]:.1e}) | {1e6 * tff / nf:.3f} ({nf} cases) |")
-    two = np.where(np.arange(nf) % 2 == 0, 1e-6, 0.8e-6)  # two oils: α per case
+    two = np.where(np.arange(nf) % 2 == 0, 1e-6, 0.8e-6)  # two oils: a G primitive each
+    cont = 1e-6 * rng.uniform(0.8, 1.0, nf)  # every row its own α: the per-case kernel
     ef2 = {}
     for (p0, al), (ref, _r) in refs.items():
         got = squeeze_out_piezo(tables, p0=[p0, p0], E_star=E, R=0.01, eta=ETA,
@@ -143,8 +144,12 @@ def bench_squeeze(lines, tables, quick, summary):
         ef2[p0 * al] = abs(got / ref - 1)
     tff2 = timed(lambda: squeeze_out_piezo(tables, p0=p0f, E_star=E, R=0.01, eta=ETA,
                                            alpha_pv=two, theory="emt"), 3)
-    lines.append(f"| fast, α per case (two oils) | – | – | {max(ef2.values()):.1e} | "
+    tff3 = timed(lambda: squeeze_out_piezo(tables, p0=p0f, E_star=E, R=0.01, eta=ETA,
+                                           alpha_pv=cont, theory="emt"), 3)
+    lines.append(f"| fast, two oils (a G primitive each) | – | – | – | "
                  f"{1e6 * tff2 / nf:.3f} ({nf} cases) |")
+    lines.append(f"| fast, α per case (every row its own; two-row calls for the error) | – | – "
+                 f"| {max(ef2.values()):.1e} | {1e6 * tff3 / nf:.3f} ({nf} cases) |")
     # per-case starts, a Δu target and ū at three times: the paths the row tables do not serve
     base0 = squeeze_out(tables, p0=p0f, E_star=E, R=0.01, eta=ETA, theory="emt", ratios=())
     usf = base0["u_inf"].to_numpy() * np.exp(rng.uniform(0.1, 5.0, nf))
@@ -152,9 +157,11 @@ def bench_squeeze(lines, tables, quick, summary):
                times=(1e-5, 1e-3, 1e-1))
     tg1 = timed(lambda: squeeze_out_piezo(tables, alpha_pv=1e-6, **gkw), 3)
     tg2 = timed(lambda: squeeze_out_piezo(tables, alpha_pv=two, **gkw), 3)
+    tg3 = timed(lambda: squeeze_out_piezo(tables, alpha_pv=cont, **gkw), 3)
     tgb = timed(lambda: squeeze_out(tables, **gkw), 3)
-    lines.append(f"| fast, given starts, Δu, ū at 3 times: one α / α per case / base | – | – "
-                 f"| – | {1e6 * tg1 / nf:.3f} / {1e6 * tg2 / nf:.3f} / {1e6 * tgb / nf:.3f} |")
+    lines.append(f"| fast, given starts, Δu, ū at 3 times: one α / two oils / α per case / "
+                 f"base | – | – | – | {1e6 * tg1 / nf:.3f} / {1e6 * tg2 / nf:.3f} / "
+                 f"{1e6 * tg3 / nf:.3f} / {1e6 * tgb / nf:.3f} |")
     tq = timed(lambda: squeeze_out(tables, p0=p0s, E_star=E, R=0.01, eta=ETA, theory="emt",
                                    method="quad"), 3)
     tf = timed(lambda: squeeze_out(tables, p0=p0f, E_star=E, R=0.01, eta=ETA, theory="emt"), 3)
@@ -162,19 +169,21 @@ def bench_squeeze(lines, tables, quick, summary):
               f"`\"fast\"` {1e6 * tf / nf:.3f} µs/case ({nf} cases). A call of one α and one "
               f"E* (\"fast\") runs the base engine's kernel on the Barus time primitive "
               f"G = T + α p0 S (fastcontact/squeeze/_barus_time.py, built per (tables, theory, "
-              f"α E*) in ~5-40 ms and kept): {tf / tff:.2f}× the base fast path's speed; with α "
-              f"per case the Barus kernel adds the correction α p0 [S(ū) − S(ū_start)] per case, "
-              f"S a series of 1-D primitives in ū (fastcontact/squeeze/_barus_primitive.py): "
-              f"{tf / tff2:.2f}×.", ""]
+              f"α E*) in ~5-40 ms and kept): {tf / tff:.2f}× the base fast path's speed; a call "
+              f"of two oils (each ≥ 20,000 rows) the same kernel on a primitive per oil: "
+              f"{tf / tff2:.2f}×; with every row its own α the Barus kernel adds the correction "
+              f"α p0 [S(ū) − S(ū_start)] per case, S a series of 1-D primitives in ū "
+              f"(fastcontact/squeeze/_barus_primitive.py): {tf / tff3:.2f}×.", ""]
     e10, t10 = per[(10, 1.0)]
     summary.append(("Barus squeeze-out", f"fast {max(ef.values()):.1e} (α per case "
                     f"{max(ef2.values()):.1e}), quad {e10:.1e} "
                     f"(GL 10, width 1): t(1.1ū∞) vs radial Reynolds reference",
-                    f"fast {nf / tff:.3g} cases/s ({tf / tff:.2f}× base; α per case "
-                    f"{nf / tff2:.3g}, {tf / tff2:.2f}×), given starts + Δu + 3 times "
-                    f"{nf / tg1:.3g} ({tgb / tg1:.2f}× base; α per case {nf / tg2:.3g}, "
-                    f"{tgb / tg2:.2f}×), quad {n / t10:.3g}; base quad {n / tq:.3g}, fast "
-                    f"{nf / tf:.3g}"))
+                    f"fast {nf / tff:.3g} cases/s ({tf / tff:.2f}× base; two oils "
+                    f"{nf / tff2:.3g}, {tf / tff2:.2f}×; α per case {nf / tff3:.3g}, "
+                    f"{tf / tff3:.2f}×), given starts + Δu + 3 times {nf / tg1:.3g} "
+                    f"({tgb / tg1:.2f}× base; two oils {tgb / tg2:.2f}×; α per case "
+                    f"{nf / tg3:.3g}, {tgb / tg3:.2f}×), quad {n / t10:.3g}; base quad "
+                    f"{n / tq:.3g}, fast {nf / tf:.3g}"))
     # where it matters: a heavy steel block on oil
     steel = fc.SelfAffinePSD(h_rms=1e-6, hurst=0.8, q0=2e4, q1=1e8)
     ts = fc.precompute(steel, theories=("emt",))
@@ -490,9 +499,11 @@ def bench_tire(lines, summary, tables, quick):
     tpt = timed(lambda: tire_footprint(tables, alpha_pv=al_f, method="fast", columns=tcols,
                                        **kw2), 3)
     tbt = timed(lambda: tire_footprint(tables, columns=tcols, **kw2), 3)
-    two = np.where(np.arange(n) % 2 == 0, al_f, 0.8 * al_f)  # two oils: the per-case kernel
+    two = np.where(np.arange(n) % 2 == 0, al_f, 0.8 * al_f)  # two oils: a G primitive each
+    cont = al_f * rng.uniform(0.8, 1.0, n)  # every row its own α: the per-case kernel
     tp2 = timed(lambda: tire_footprint(tables, alpha_pv=two, method="fast", **kw2), 3)
-    tpt2 = timed(lambda: tire_footprint(tables, alpha_pv=two, method="fast", columns=tcols,
+    tp3 = timed(lambda: tire_footprint(tables, alpha_pv=cont, method="fast", **kw2), 3)
+    tpt2 = timed(lambda: tire_footprint(tables, alpha_pv=cont, method="fast", columns=tcols,
                                         **kw2), 3)
     fa = tire_footprint(tables, alpha_pv=al_f, method="fast", **kq)
     qa = tire_footprint(tables, alpha_pv=al_f, method="quad", **kq)
@@ -512,12 +523,15 @@ def bench_tire(lines, summary, tables, quick):
               f"exit) fast {n / tpt:.3g} cases/s, base {n / tbt:.3g}. One α and one E* in "
               f"the call: the base engine's kernel on the Barus time primitive "
               f"(fastcontact/squeeze/_barus_time.py); two oils (α = {al_f:g} and "
-              f"{0.8 * al_f:g} 1/Pa alternating): the per-case Barus kernel, {n / tp2:.3g} "
-              f"cases/s (target columns only {n / tpt2:.3g}).", ""]
+              f"{0.8 * al_f:g} 1/Pa alternating): the same kernel on a primitive per oil, "
+              f"{n / tp2:.3g} cases/s ({tb / tp2:.2f}× base); every row its own α (uniform in "
+              f"0.8-1 × {al_f:g}): the per-case Barus kernel, {n / tp3:.3g} cases/s "
+              f"({tb / tp3:.2f}× base; target columns only {n / tpt2:.3g}).", ""]
     summary.append(("Barus tire footprint", f"t(1.1ū∞) {err_t:.1e}, ū_exit (as time) "
                     f"{err_u:.1e}; α = 0 ≡ base bit for bit",
-                    f"fast {n / tp:.3g} cases/s ({tb / tp:.2f}× base; α per case "
-                    f"{n / tp2:.3g}, {tb / tp2:.2f}×), quad {nq / tpq:.3g}; base {n / tb:.3g}; "
+                    f"fast {n / tp:.3g} cases/s ({tb / tp:.2f}× base; two oils "
+                    f"{n / tp2:.3g}, {tb / tp2:.2f}×; α per case {n / tp3:.3g}, "
+                    f"{tb / tp3:.2f}×), quad {nq / tpq:.3g}; base {n / tb:.3g}; "
                     f"target columns only: fast {n / tpt:.3g} (α per case {n / tpt2:.3g}), "
                     f"base {n / tbt:.3g}"))
 

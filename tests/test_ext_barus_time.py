@@ -24,7 +24,7 @@ from reference.ext_reynolds import squeeze_time  # noqa: E402
 
 import fastcontact as fc  # noqa: E402
 from fastcontact.squeeze import _barus_primitive as bp  # noqa: E402
-from fastcontact.squeeze._barus_time import served_rows  # noqa: E402
+from fastcontact.squeeze import _barus_time as btime  # noqa: E402
 from fastcontact.squeeze._primitive_eval import row_value, stencil, t_of_z  # noqa: E402
 from fastcontact.squeeze.model import squeeze_model  # noqa: E402
 from fastcontact.squeeze.tire import tire_footprint  # noqa: E402
@@ -39,14 +39,22 @@ def tables():
     return fc.precompute(psd, theories=("critical_junction", "emt"))
 
 
-def _served(tables, theory, p0, alpha, u_start):
+def _groups(tables, theory, p0, alpha, u_start, E_star=E_STAR):
+    """served_groups of the cases: ([(G primitive, rows it serves), ...], other rows)."""
     m = squeeze_model(tables, theory)
     p0 = np.atleast_1d(np.asarray(p0, dtype=float))
     n = p0.size
-    return served_rows(m, fast_setup(tables, theory, None), p0, np.full(n, E_STAR),
-                       np.broadcast_to(np.asarray(alpha, dtype=float), (n,)).copy(),
-                       np.broadcast_to(np.asarray(u_start, dtype=float), (n,)).copy(),
-                       tables.h_rms)
+    return btime.served_groups(
+        m, fast_setup(tables, theory, None), p0,
+        *(np.broadcast_to(np.asarray(a, dtype=float), (n,)).copy()
+          for a in (E_star, alpha, u_start)), tables.h_rms)
+
+
+def _served(tables, theory, p0, alpha, u_start):
+    """(G primitive or None, rows it serves, other rows) of a call of one fluid."""
+    groups, rest = _groups(tables, theory, p0, alpha, u_start)
+    assert len(groups) <= 1
+    return (*groups[0], rest) if groups else (None, rest[:0], rest)
 
 
 @njit(cache=True)
@@ -185,7 +193,7 @@ def test_one_fluid_squeeze_out_against_quadrature_random(tables, theory):
         _bg, idx, _rest = _served(tables, theory, p0, alpha, np.nan if us is None else us)
         fast = squeeze_out_piezo(tables, method="fast", **kw)
         quad = squeeze_out_piezo(tables, method="quad", **kw)
-        prov = fast.attrs["barus_time_primitive"]           # provenance of the served rows
+        prov, = fast.attrs["barus_time_primitive"]          # provenance of the served rows
         assert prov["cases_served"] == idx.size and prov["alpha_E_star"] == alpha * E_STAR
         assert list(fast.status) == list(quad.status)
         served = np.zeros(n, dtype=bool)

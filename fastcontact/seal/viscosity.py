@@ -156,8 +156,9 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         half as many steps: Barus with FALLBACK_STEPS, Roelands with HERTZ_STEPS, then, where
         the two differ by more than FALLBACK_RTOL, with FALLBACK_STEPS; "not_converged"
         (Q = NaN) where they still differ. An integer: shooting with that many steps,
-        unchecked (both laws). A call of at least TABLE_MIN_ROWS O-rings of one fluid (α, or
-        the Roelands law) and one E* (p_b = 0) reads W from that fluid's verified O-ring table
+        unchecked (both laws). At least TABLE_MIN_ROWS (500) O-rings of one fluid (α E*, or
+        the Roelands law with p_r/E*; in a call of several fluids, each of the four largest
+        such groups) with p_b = 0 read W from that fluid's verified O-ring table
         (:mod:`fastcontact.seal.hertz`, built as far as needed and kept; ~1e-8 of the solver)
         where building what it lacks costs fewer solves than the rows (Δp sweeps of a few
         O-rings, a large study, a table kept from an earlier call), and solves only the rows
@@ -650,37 +651,67 @@ def _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha):
 
 
 def _barus_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, alpha):
-    """:func:`_barus_hertz_k`, the rows of one Barus fluid on one rubber (one α̃ = α E*) from
-    the fluid's verified O-ring table where it pays (:func:`_hertz_k_tabled`)."""
+    """:func:`_barus_hertz_k`, the rows of one Barus fluid on one rubber (one α̃ = α E* > 0, at
+    least TABLE_MIN_ROWS of them: :func:`_by_fluid`) from the fluid's verified O-ring table
+    where it pays (:func:`_hertz_k_tabled`)."""
     al = alpha * E
     args = (E, pH, a, pa, pb, alpha)
-    if E.size < TABLE_MIN_ROWS or not (al.min() == al.max() and al[0] > 0.0):
-        return _barus_hertz_k(tables, theory, *args)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        psia = -np.expm1(-alpha * (pa - pb)) / alpha  # [Pa], α > 0 here
-    return _hertz_k_tabled(tables, theory, E, pH, a, pa, pb, float(al[0]), None,
-                           lambda i: psia[i],
-                           lambda i: _barus_hertz_k(tables, theory, *(x[i] for x in args)))
+
+    def one_fluid(key, i):
+        sub = [x[i] for x in args]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            psia = -np.expm1(-sub[5] * (sub[3] - sub[4])) / sub[5]  # [Pa], α > 0 here
+        return _hertz_k_tabled(tables, theory, *sub[:5], key[0], None, lambda j: psia[j],
+                               lambda j: _barus_hertz_k(tables, theory, *(x[j] for x in sub)))
+    return _by_fluid((al,), al > 0.0, one_fluid,
+                     lambda i: _barus_hertz_k(tables, theory, *(x[i] for x in args)))
 
 
 def _roelands_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, A, Z, pr):
     """:func:`_roelands_hertz_k`, the rows of one Roelands fluid on one rubber (one law
-    (A, Z, p_r/E*)) from the fluid's verified O-ring table where it pays
-    (:func:`_hertz_k_tabled`)."""
+    (A, Z, p_r/E*), at least TABLE_MIN_ROWS of them: :func:`_by_fluid`) from the fluid's
+    verified O-ring table where it pays (:func:`_hertz_k_tabled`)."""
     n = E.size
     pr = np.broadcast_to(np.asarray(pr, dtype=np.float64), (n,))  # p_r: one or per row
     prn = pr / E
     args = (E, pH, a, pa, pb, A, Z, pr)
-    if n < TABLE_MIN_ROWS or not all(x.min() == x.max() for x in (A, Z, prn)):
-        return _roelands_hertz_k(tables, theory, *args)
 
-    def psia(i):  # E* ψ_a [Pa] from the law's tabulated ψ
-        out = np.empty(i.size)
-        psi_drops(*(np.ascontiguousarray(x[i], dtype=np.float64) for x in
-                    (A, Z, prn, (pa - pb) / E)), out)
-        return E[i] * out
-    return _hertz_k_tabled(tables, theory, E, pH, a, pa, pb, 0.0, (A[0], Z[0], prn[0]), psia,
-                           lambda i: _roelands_hertz_k(tables, theory, *(x[i] for x in args)))
+    def one_fluid(key, i):
+        sub = [x[i] for x in args]
+
+        def psia(j):  # E* ψ_a [Pa] from the law's tabulated ψ
+            out = np.empty(j.size)
+            psi_drops(*(np.ascontiguousarray(x[j], dtype=np.float64) for x in
+                        (sub[5], sub[6], prn[i], (sub[3] - sub[4]) / sub[0])), out)
+            return sub[0][j] * out
+        return _hertz_k_tabled(tables, theory, *sub[:5], 0.0, key, psia,
+                               lambda j: _roelands_hertz_k(tables, theory, *(x[j] for x in sub)))
+    return _by_fluid((A, Z, prn), np.ones(n, dtype=bool), one_fluid,
+                     lambda i: _roelands_hertz_k(tables, theory, *(x[i] for x in args)))
+
+
+def _by_fluid(keys, eligible, one_fluid, solve):
+    """(k [Pa/m], converged) of O-rings whose fluid is given per row by ``keys`` (arrays): the
+    ``eligible`` rows of each fluid with at least TABLE_MIN_ROWS rows (at most PIEZO_TABLES
+    fluids, the largest, as many as a seal context keeps tables of) by ``one_fluid(key,
+    rows)``, every other row by ``solve(rows)``; each -> (k, converged) of those rows."""
+    from .._core.groups import row_groups
+    from .hertz import PIEZO_TABLES
+    n = keys[0].size
+    k = np.empty(n)
+    ok = np.empty(n, dtype=bool)
+    rest = np.ones(n, dtype=bool)
+    pick = np.flatnonzero(eligible) if n >= TABLE_MIN_ROWS else np.zeros(0, dtype=np.int64)
+    for key, rows in row_groups([x[pick] for x in keys], TABLE_MIN_ROWS, PIEZO_TABLES):
+        i = pick[rows]
+        k[i], ok[i] = one_fluid(key, i)
+        rest[i] = False
+    if rest.all():
+        return solve(np.arange(n))
+    if rest.any():
+        i = np.flatnonzero(rest)
+        k[i], ok[i] = solve(i)
+    return k, ok
 
 
 def _hertz_k_tabled(tables, theory, E, pH, a, pa, pb, al, vis, psia, solve):
@@ -710,8 +741,9 @@ def _hertz_k_tabled(tables, theory, E, pH, a, pa, pb, al, vis, psia, solve):
     return k, ok
 
 
-#: fewest O-ring rows of one fluid (Barus or Roelands) for which :func:`_hertz_k_tabled` is
-#: tried (the table used where it pays) instead of solving each row (~70-100 µs a row)
+#: fewest O-ring rows of one fluid (Barus or Roelands; in a call of several fluids, of each)
+#: for which :func:`_hertz_k_tabled` is tried (the table used where it pays) instead of
+#: solving each row (~70-100 µs a row)
 TABLE_MIN_ROWS = 500
 
 

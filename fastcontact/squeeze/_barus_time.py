@@ -6,8 +6,9 @@ With a Barus fluid the reduced time from v_s down to v is G(x0, v) - G(x0, v_s),
 
 T the constant-viscosity time primitive (:mod:`.primitive`) and S the Barus correction of
 :mod:`._barus_primitive`. Where every case of a call shares α and E* (one oil or water, one
-tread compound: the usual tire or road study), A is a function of x0 = ln(p0/E*) alone, so G is
-a function of (x0, z) as T is: it is tabulated here on the base primitive's own rows and z
+tread compound: the usual tire or road study; or the rows of one α E* in a call of several,
+:func:`served_groups`), A is a function of x0 = ln(p0/E*) alone, so G is a function of (x0, z)
+as T is: it is tabulated here on the base primitive's own rows and z
 nodes, as ln G with its first two z-derivatives (exact at the nodes),
 
     dG/dz   = T'/g(a),                     a = A (1 - y),  y = π_c(v)/π0,
@@ -39,6 +40,7 @@ from threading import Lock
 import numpy as np
 from numba import njit, prange
 
+from .._core.groups import row_groups
 from ..kernels.readonly import readonly, readonly_fields
 from . import _kernels as qk
 from ._barus_primitive import API_FAST, K_MAX, s_at, s_cell, series_order, shift
@@ -46,7 +48,7 @@ from ._fastpath import fast_kernel, row_targets
 from ._primitive_eval import Primitive, _index_map, _locate, lagrange_denominators
 from .viscosity import _rate_factor, _rate_factor_array
 
-__all__ = ["A_ROW_MAX", "BarusTime", "barus_time"]
+__all__ = ["A_ROW_MAX", "BarusTime", "MIN_GROUP_ROWS", "barus_time", "served_groups"]
 
 #: largest A = α p0 of a row of the G primitive (the stencil's rows beyond API_FAST): the
 #: truncated series of K_MAX terms is exact there to c_49 A^50 < 1e-12
@@ -71,7 +73,7 @@ _NO_TABLE = readonly(np.zeros(2))
 
 _MEMO: OrderedDict = OrderedDict()
 _LOCK = Lock()
-_MEMO_SIZE = 4
+_MEMO_SIZE = 8
 
 
 def barus_time(model, pr, bt, c, x_fast, aE, v_max):
@@ -194,30 +196,85 @@ def _build_row(pr, bt, c, aE, nz, j, C):
         C[j, k, 2] = G2 / G - l1 * l1
 
 
-def served_rows(model, setup, p, E, alpha, us_in, h):
-    """(BarusTime or None, indices of the rows it serves, indices of the others) of Barus
-    cases (p0 [Pa], E* [Pa], α [1/Pa], ū(0) [m] (NaN: the default start) per row): the G
-    primitive serves a call whose rows share α and E* — rows with ln(p0/E*) in the tables and
-    at most ``x_served``, a start finite (or the default); the grid is built to reach the
-    highest such start."""
+#: a call of several fluids or rubbers builds the G primitive of a group (the rows of one
+#: α E*) of at least this many rows: a build costs 10-40 ms on 2 cores, what the per-case
+#: kernel spends on 2-5e4 rows more than the base kernel (measured on the embedded road tables);
+#: a smaller group runs the per-case kernel unless its primitive is kept from an earlier call.
+#: A call of one fluid on one rubber always builds it (a study's later calls reuse it).
+MIN_GROUP_ROWS = 20_000
+
+
+def served_groups(model, setup, p, E, alpha, us_in, h):
+    """([(BarusTime, indices of the rows it serves), ...], indices of the other rows) of Barus
+    cases (p0 [Pa], E* [Pa], α [1/Pa], ū(0) [m] (NaN: the default start), one per row).
+
+    Rows of one α E* form a group (G depends on α and E* through their product alone),
+    served by that group's G primitive where it is built: a call of one group; a group of
+    at least MIN_GROUP_ROWS rows, or one whose primitive is kept from an earlier call, at most
+    _MEMO_SIZE per call, the largest first. The rows of
+    α = 0 form one group whatever their E*, served by the constant-viscosity primitive itself
+    (G = T: the base engine's numbers). Within a group the rows with ln(p0/E*) in the tables
+    and at most its ``x_served`` and a finite start (or the default) are served; its grid is
+    built to reach their highest start."""
     n = p.size
     every = np.arange(n)
-    if n == 0 or not (alpha.min() == alpha.max() and E.min() == E.max()) or alpha[0] <= 0.0:
-        return None, every[:0], every
-    pr, bt, c, x_fast = setup
-    aE = float(alpha[0] * E[0])
+    if n == 0:
+        return [], every
     x0 = np.log(p / E)
-    ok = ((x0 >= model.mp.x_min) & (x0 <= min(x_fast, math.log(API_FAST / aE)))
-          & ~(us_in == math.inf))
+    prod = alpha * E  # G depends on α and E* through α E* alone (0 exactly where α = 0)
+    groups = [(float(prod[0]), every)] if prod.min() == prod.max() else _groups(model, prod)
+    served, done = [], np.zeros(n, dtype=bool)
+    for aE, rows in groups:
+        bg, ok = _group_primitive(model, setup, aE, x0[rows], us_in[rows], h)
+        if bg is not None and ok.any():
+            served.append((bg, rows[ok]))
+            done[rows[ok]] = True
+    return served, every[~done]
+
+
+def _groups(model, prod):
+    """[(α E*, rows), ...] of a call of several α E* = ``prod`` (one per row): the rows of α = 0
+    first, then the groups whose G primitive (of ``model``) is kept or which have at least
+    MIN_GROUP_ROWS rows, the largest first, at most _MEMO_SIZE (:func:`served_groups`)."""
+    out = []
+    zero = prod == 0.0
+    if zero.any():
+        out.append((0.0, np.flatnonzero(zero)))
+    idx = np.flatnonzero(~zero)
+    if idx.size:
+        mkey = model.key()
+        with _LOCK:
+            kept = [(k[1],) for k in _MEMO if k[0] == mkey]
+        out += [(key[0], idx[rows]) for key, rows in
+                row_groups([prod[idx]], MIN_GROUP_ROWS, _MEMO_SIZE, kept)]
+    return out
+
+
+def _group_primitive(model, setup, aE, x0, us_in, h):
+    """(BarusTime or None, mask of the rows it serves) of one group: α E* = ``aE``, the rows'
+    ln(p0/E*) ``x0`` and starts ``us_in`` [m]."""
+    pr, bt, c, x_fast = setup
+    finite = ~(us_in == math.inf)
+    if aE == 0.0:  # constant viscosity: the base primitive is G, its tail closed-form
+        return BarusTime(pr, x_fast, math.inf, 0.0), ((x0 >= model.mp.x_min) & (x0 <= x_fast)
+                                                      & finite)
+    ok = (x0 >= model.mp.x_min) & (x0 <= min(x_fast, math.log(API_FAST / aE))) & finite
     if not ok.any():
-        return None, every[:0], every
+        return None, ok
     v_s = us_in[ok] / h
     bg = barus_time(model, pr, bt, c, x_fast, aE,
                     float(np.max(v_s[np.isfinite(v_s)], initial=0.0)))
     if bg is None:
-        return None, every[:0], every
-    ok &= x0 <= bg.x_served
-    return bg, every[ok], every[~ok]
+        return None, ok
+    return bg, ok & (x0 <= bg.x_served)
+
+
+def group_info(bg, rows, over=0):
+    """Provenance of one group's G primitive (``rows`` served, ``over`` of them handed back to
+    the per-case kernel)."""
+    return {"alpha_E_star": bg.aE, "rows": int(bg.pr.xn.size), "z_nodes": int(bg.pr.nz),
+            "max_ln_p0_over_E_star": bg.x_served, "cases_served": int(rows.size - over),
+            "primitive": "constant viscosity (alpha_pv = 0)" if bg.aE == 0.0 else "Barus G"}
 
 
 def _base_inputs(bg, cs, idx, every, ratios, dvs, times2d, h):
@@ -305,7 +362,8 @@ def squeeze_rows(model, bg, cs, tg, h, quad, out, idx):
     # the default start is where p_cont = DEFAULT_P_START p0: y there needs no table
     y_default = DEFAULT_P_START if np.isnan(us).all() else -1.0
     status = out.status if every else np.empty(ng, dtype=np.int8)
-    gx = default_rate_table(bg, y_default) if y_default >= 0.0 else _NO_TABLE
+    # α = 0 (the base primitive): g = 1 exactly from _rate_factor(0), no table
+    gx = default_rate_table(bg, y_default) if y_default >= 0.0 and bg.aE > 0.0 else _NO_TABLE
     _g_start_kernel(model.barus_table()[0], bg.aE, csg.p0, csg.E, o.u_start, h, y_default, gx,
                     code, np.int8(ST_OK), np.int8(ST_BELOW), gs, status)
     if not every:

@@ -317,10 +317,12 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
     alpha_pv : array_like, default 0.0
         Barus pressure–viscosity coefficient α [1/Pa] >= 0, η = η0 exp(α p_f) (issue 14).
         Rows with α > 0 run the Barus engine (exact reduced-pressure rate factor): with
-        ``method="fast"`` and one α and one E* in the call, the base engine's kernel on the
-        Barus time primitive built for them (:mod:`fastcontact.squeeze._barus_time`, the
-        base tire's speed); with α or E* per case the time primitive plus the tabulated
-        Barus correction per case (:mod:`fastcontact.squeeze._barus_fast`); rows with
+        ``method="fast"`` the rows of one α E* — every row of a call of one fluid on one
+        rubber, groups of at least 20,000 rows (or with a kept primitive) of a call of
+        several — the base engine's kernel on the Barus time primitive built for them
+        (:mod:`fastcontact.squeeze._barus_time`, the base tire's speed); other rows (every
+        row its own α or E*, small groups) the time primitive plus the tabulated Barus
+        correction per case (:mod:`fastcontact.squeeze._barus_fast`); rows with
         α p_eval > 0.6 or next to the trap pressure by quadrature in the same pass; with
         "quad" the per-case quadrature
         of :mod:`fastcontact.squeeze.tire_piezo`; status "piezo_limit" with NaN results where

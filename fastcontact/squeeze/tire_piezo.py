@@ -103,16 +103,16 @@ def _tire_kernel(tab, sc, cs, alpha, t_fp, h, tg, quad, out):
 
 
 def _fast_rows(tables, theory, tab, sc, cs, al, tf, h, tg, quad, res):
-    """method "fast": the rows the G primitive serves (one α and one E* for the call:
-    :mod:`._barus_time`, the base engine's kernel) and the others by the Barus kernel
-    (:func:`._barus_fast.tire_kernel`), into ``res``."""
+    """method "fast": the rows a G primitive serves (the rows of one α E* of a call:
+    :func:`._barus_time.served_groups`, the base engine's kernel) and the others by the Barus
+    kernel (:func:`._barus_fast.tire_kernel`), into ``res``."""
     from ._barus_fast import ratio_rows, tire_kernel
-    from ._barus_time import run_rest, served_rows, tire_rows
+    from ._barus_time import run_rest, served_groups, tire_rows
     from .model import squeeze_model
     setup = fast_setup(tables, theory, None)
     model = squeeze_model(tables, theory)
-    bg, gi, rest = served_rows(model, setup, cs.p0, cs.E, al, cs.us, h)
-    if gi.size:
+    groups, rest = served_groups(model, setup, cs.p0, cs.E, al, cs.us, h)
+    for bg, gi in groups:
         tire_rows(model, bg, cs, tf, h, tg.ratios[1:], tg.dvs, quad, res, gi)
 
     def per_case(sub, part):

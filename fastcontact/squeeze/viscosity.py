@@ -418,12 +418,14 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
         Times [s] >= 0 (inf allowed) → columns ``u_at_<t>``: ū at that time [m] (ū(0) =
         u_start; ū∞, or ū_trap on a trapped row, as t → ∞).
     method : {"fast", "quad"}, default "fast"
-        "fast": a call of one α and one E* runs the base engine's kernel on the Barus time
-        primitive G = T + α p0 S built for them (:mod:`._barus_time`, ~5-40 ms, kept), at
-        the base engine's speed; with α or E* per case every time is two interpolations of
-        the constant-viscosity time primitive plus the tabulated Barus correction
-        (:mod:`._barus_primitive`, built once per tables and theory in ~5-20 ms); rows
-        neither serves (α p0 > 0.6, p0 within 4.4 % of
+        "fast": the rows of one α E* run the base engine's kernel on the Barus time
+        primitive G = T + α p0 S built for them (:mod:`._barus_time`, ~5-40 ms, kept for the
+        last eight): every row of a call of one fluid on one rubber, the groups of at least
+        20,000 rows (or with a kept primitive) of a call of several, and the rows of α = 0
+        (the constant-viscosity primitive itself) — at the base engine's speed; other rows
+        take two interpolations of the constant-viscosity time primitive plus the tabulated
+        Barus correction per time (:mod:`._barus_primitive`, built once per tables and
+        theory in ~5-20 ms); rows neither serves (α p0 > 0.6, p0 within 4.4 % of
         the trap pressure or beyond, outside the tables) take the per-case quadrature in the
         same pass. "quad": the per-case quadrature for every row.
     quad_order, quad_width :
@@ -494,22 +496,23 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
 
 
 def _fast_rows(tables, theory, sigma_trap, sc, cs, al, h, tg, quad, out):
-    """method "fast": the rows the Barus time primitive serves (a call of one α and one E*:
-    :mod:`._barus_time`, the base engine's kernel), the others by the per-case Barus kernel
-    (:func:`._barus_fast.squeeze_kernel`), into ``out`` (:data:`BarusOut`). Returns the
-    primitive's provenance (None where it served no row)."""
+    """method "fast": the rows a time primitive serves (the rows of one α E* of a call:
+    :func:`._barus_time.served_groups`, the base engine's kernel on their G primitive), the
+    others by the per-case Barus kernel (:func:`._barus_fast.squeeze_kernel`), into ``out``
+    (:data:`BarusOut`). Returns the provenance of each group's primitive (None where no row
+    was served)."""
     from ._barus_fast import ratio_rows, squeeze_kernel
-    from ._barus_time import run_rest, served_rows, squeeze_rows
+    from ._barus_time import group_info, run_rest, served_groups, squeeze_rows
     setup = fast_setup(tables, theory, sigma_trap)
     model = squeeze_model(tables, theory, sigma_trap)
-    bg, gi, rest = served_rows(model, setup, cs.p0, cs.E, al, cs.us, h)
-    if gi.size:
+    groups, rest = served_groups(model, setup, cs.p0, cs.E, al, cs.us, h)
+    info = []
+    for bg, gi in groups:
         over = squeeze_rows(model, bg, cs, tg, h, quad, out, gi)
         if over.size:
-            rest = np.sort(np.concatenate((rest, gi[over])))
-    info = None if bg is None or rest.size == cs.p0.size else {
-        "alpha_E_star": bg.aE, "rows": int(bg.pr.xn.size), "z_nodes": int(bg.pr.nz),
-        "max_ln_p0_over_E_star": bg.x_served, "cases_served": int(cs.p0.size - rest.size)}
+            rest = np.concatenate((rest, gi[over]))
+        info.append(group_info(bg, gi, over.size))
+    rest = np.sort(rest)
 
     def per_case(sub, part):
         squeeze_kernel(tables.kernel_data(theory), sc, *setup, Cases(*(sub(a) for a in cs)),
@@ -518,7 +521,7 @@ def _fast_rows(tables, theory, sigma_trap, sc, cs, al, h, tg, quad, out):
         per_case(lambda a: a, out)
     elif rest.size:  # the others as a call of their own
         run_rest(out, rest, per_case)
-    return info
+    return info if any(g["cases_served"] for g in info) else None
 
 
 def fast_setup(tables, theory, sigma_trap):
