@@ -305,6 +305,11 @@ def bench_seal(lines, tables, quick, summary):
         q_dir = seal_leak_piezo(tables, alpha_pv=al_t, **okw).Q.to_numpy()
         t_dir = time.perf_counter() - t0
     t_base = timed(lambda: seal_leak(tables, **okw), 3)
+    two_o = np.where(np.arange(no) % 2 == 0, al_t, 0.8 * al_t)  # two oils: a table each
+    seal_leak_piezo(tables, alpha_pv=0.8 * al_t, **okw)  # the second oil's, by a call of its own
+    t_two = timed(lambda: seal_leak_piezo(tables, alpha_pv=two_o, **okw), 3)
+    t_two_solve = timed(lambda: seal_leak_piezo(tables, alpha_pv=two_o * (1.0 + 1e-9), **okw),
+                        1)  # two oils without kept tables: 10,000 scattered O-rings each
     fin = np.isfinite(q_dir) & (q_dir > 0)
     e_tab = float(np.max(np.abs(q_tab[fin] / q_dir[fin] - 1)))
     e_ref = max(abs(q_tab[i] / (hertz_shoot(sig, pHo[i], ao[i], okw["dp"][i], 0.0, al_t) * Ly)
@@ -316,12 +321,15 @@ def bench_seal(lines, tables, quick, summary):
               f"{no / t_tab:.3g} rows/s (the call that builds it {no / t_first:.3g}), the "
               f"per-row solver {no / t_dir:.3g} rows/s, base `seal_leak` (its table) "
               f"{no / t_base:.3g}; Q within {e_tab:.1e} of the solver's, {e_ref:.1e} of the "
-              f"DOP853 shooting (two rows).", ""]
+              f"DOP853 shooting (two rows). Two oils in one call (α = {al_t:g} and "
+              f"{0.8 * al_t:g} 1/Pa alternating), each oil's table kept from a call of its own: "
+              f"{no / t_two:.3g} rows/s; two other oils, no table kept ({no // 2} scattered "
+              f"O-rings each do not pay for building one): {no / t_two_solve:.3g} rows/s.", ""]
     summary.append(("Barus seal", f"O-ring {e_pan:.1e} by panels (DOP853 shooting); one "
                     f"fluid's O-ring table {e_ref:.1e} (shooting), {e_tab:.1e} (solver)",
                     f"O-rings of one fluid from its table {no / t_tab:.3g} rows/s (base table "
                     f"{no / t_base:.3g}; the call that builds it {no / t_first:.3g}, per-row "
-                    f"solver {no / t_dir:.3g}); O-ring sweep {dps.size / t_pan:.3g} rows/s (rows cold, no chains "
+                    f"solver {no / t_dir:.3g}; two oils {no / t_two:.3g}); O-ring sweep {dps.size / t_pan:.3g} rows/s (rows cold, no chains "
                     f"{dps.size / t_cold:.3g}; 200-step shooting "
                     f"{dps.size / t200:.3g}; base table {dps.size / tb:.3g}, base direct "
                     f"{dps.size / tbd:.3g}); flat ring, Δp sweep "
