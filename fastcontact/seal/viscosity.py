@@ -706,8 +706,6 @@ def _by_fluid(keys, eligible, one_fluid, solve):
         i = pick[rows]
         k[i], ok[i] = one_fluid(key, i)
         rest[i] = False
-    if rest.all():
-        return solve(np.arange(n))
     if rest.any():
         i = np.flatnonzero(rest)
         k[i], ok[i] = solve(i)

@@ -254,11 +254,10 @@ def _group_primitive(model, setup, aE, x0, us_in, h):
     """(BarusTime or None, mask of the rows it serves) of one group: α E* = ``aE``, the rows'
     ln(p0/E*) ``x0`` and starts ``us_in`` [m]."""
     pr, bt, c, x_fast = setup
-    finite = ~(us_in == math.inf)
+    x_hi = x_fast if aE == 0.0 else min(x_fast, math.log(API_FAST / aE))
+    ok = (x0 >= model.mp.x_min) & (x0 <= x_hi) & ~(us_in == math.inf)
     if aE == 0.0:  # constant viscosity: the base primitive is G, its tail closed-form
-        return BarusTime(pr, x_fast, math.inf, 0.0), ((x0 >= model.mp.x_min) & (x0 <= x_fast)
-                                                      & finite)
-    ok = (x0 >= model.mp.x_min) & (x0 <= min(x_fast, math.log(API_FAST / aE))) & finite
+        return BarusTime(pr, x_fast, math.inf, 0.0), ok
     if not ok.any():
         return None, ok
     v_s = us_in[ok] / h
