@@ -1,6 +1,7 @@
 """Quadrature rules and closed-form power-law moments, defined once for the whole package.
 
 - :func:`gauss_legendre` — the only source of Gauss–Legendre nodes (cached per order).
+- :func:`gauss_lobatto` — Gauss–Lobatto nodes (panel ends included).
 - :func:`gauss_kronrod15` — the 7/15-point Gauss–Kronrod pair (adaptive integrals).
 - :func:`gauss_hermite` — Gauss–Hermite nodes (Gaussian averages).
 - :func:`seg_moment` / :func:`seg_moment_np` — ∫ q^n c (q/q_s)^e dq over one power-law
@@ -14,9 +15,9 @@ import numpy as np
 from numba import njit
 
 from .powerlaw import seg_moment_np
-from .rules import GL_ORDER, QuadRule, gauss_hermite, gauss_legendre
+from .rules import GL_ORDER, QuadRule, gauss_hermite, gauss_legendre, gauss_lobatto
 
-__all__ = ["QuadRule", "gauss_legendre", "gauss_kronrod15", "gauss_hermite", "seg_moment",
+__all__ = ["QuadRule", "gauss_legendre", "gauss_lobatto", "gauss_kronrod15", "gauss_hermite", "seg_moment",
            "seg_moment_constants", "seg_moment_at", "seg_moment_np", "GL_ORDER"]
 
 _XGK = np.array([-0.991455371120812639206854697526329, -0.949107912342758524526189684047851,

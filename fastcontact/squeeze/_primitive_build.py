@@ -3,7 +3,8 @@
 Part of :mod:`fastcontact.squeeze.primitive`. The x0-independent state (ln π_c, ln σ̄ and
 their ln v-derivatives) is tabulated once on a fine grid in ln v (:func:`profile`); each x0
 row then integrates T(x0, v) = ∫_v^∞ dv'/(σ̄ (1 - π_c/π0)) (Lorenz & Persson 2010, eqs. (18),
-(19), (23); arXiv:1004.1037) with composite Gauss–Legendre panels in z = ln(v/v∞ - 1), and
+(19), (23); arXiv:1004.1037) with composite Gauss–Lobatto panels in z = ln(v/v∞ - 1) between
+the nodes (the panel ends are the nodes, whose integrand the derivatives need anyway), and
 :func:`measure_error` checks the interpolant against direct quadrature at cell centres.
 """
 from __future__ import annotations
@@ -15,25 +16,48 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, prange
 
+from ..kernels.balance import spread_order
 from ..kernels.hermite import cubic_basis
-from ..kernels.quadrature import gauss_legendre
+from ..kernels.quadrature import gauss_legendre, gauss_lobatto
 from ..kernels.readonly import readonly_fields
 from . import _kernels as qk
 from ._primitive_eval import (Primitive, _index_map, lagrange_denominators, one_plus_exp,
                               row_value, stencil, t_of_z)
 
 __all__ = ["build", "measure_error", "profile", "fast_limit", "Profile", "DXI", "Z_LO", "DZ",
-           "NODE_ORDER", "X_END", "X_FALLBACK"]
+           "NODE_POINTS", "THEORY_NODE_POINTS", "node_points", "CHECK_ORDER", "X_END",
+           "X_FALLBACK"]
 
-#: grid spacing in ξ = x0 - ln σ̄(x0) of the x0 rows
+#: grid spacing in ξ = x0 - ln σ̄(x0) of the x0 rows. The rows also carry ln v∞, which the
+#: 4-point stencil keeps within ~4e-9 of the tables' inverse (at 0.15: 2.2e-8, more than the
+#: ū - ū∞ tolerance of 1e-8 ū∞ close to equilibrium)
 DXI = 0.1
 #: z = ln(v/v∞ - 1) grid: lower end and spacing (below: analytic log singularity). The
 #: spacing sets the quintic's error in z: on the embedded road tables' critical-junction
 #: primitive, every served cell centre, 1.1e-6 at 0.25, 3.7e-7 at 0.2 (EMT 8e-8, average 2e-8)
 Z_LO = -10.0
 DZ = 0.2
-#: Gauss–Legendre order per z panel of the node quadrature
-NODE_ORDER = 6
+#: Gauss–Lobatto points per z panel of the node quadrature (:data:`THEORY_NODE_POINTS` per
+#: theory); a panel's ends are the nodes, whose integrand each node computes anyway, so 7
+#: points cost 5 new integrand values a node (6-point Gauss–Legendre, before 2026-12-02: 6).
+#: Node ln T against 12-point Gauss–Legendre panels, critical junction and EMT on six spectra
+#: (the embedded four, a synthetic road, a self-affine one of 5 decades): 2.1e-8–1.1e-7 at 7
+#: points, 2.0e-8–1.5e-7 with the 6 Gauss–Legendre points (the integrand is only piecewise
+#: smooth: the profile is a C¹ cubic), 1e-6–2e-5 at 4
+NODE_POINTS = 7
+#: theories whose node quadrature converges with fewer points: the average theory's σ̄ is
+#: smooth, its node ln T at 5 points within 1.1e-10–3.3e-10 of 12-point Gauss–Legendre on the
+#: same spectra (the cell-centre interpolation error is ~1e-8); its build has the most rows
+THEORY_NODE_POINTS = {"average": 5}
+#: Gauss–Legendre order of :func:`measure_error`'s direct quadrature (panels of dz/4)
+CHECK_ORDER = 6
+
+
+def node_points(theory):
+    """Gauss–Lobatto points per z panel of the primitive's node quadrature for ``theory``."""
+    return THEORY_NODE_POINTS.get(theory, NODE_POINTS)
+
+
 #: relative step of the central difference for dh/dz at the nodes
 HZ = 1e-4
 
@@ -138,13 +162,12 @@ def _h(pf, mp, x0, vinf, z):
 
 
 @njit(cache=True)
-def _h_dlnh(pf, mp, x0, vinf, z):
-    """(h, d ln h/dz) at z (exact derivative of the profile's h)."""
-    e = vinf * math.exp(z)
+def _h_dlnh(pf, mp, x0, vinf, e):
+    """(h, d ln h/dz) at e = v∞ e^z (exact derivative of the profile's h)."""
     v = vinf + e
     lp, lm, de, dl = _pstate(pf, mp, v)
     dd = -math.expm1(lp - x0)
-    q = math.exp(lp - x0)
+    q = 1.0 - dd  # π_c/π0 (its absolute error ~1e-16 only scales an O(1) term below)
     r = e / v
     return e / (math.exp(lm) * dd), 1.0 - r * dl + r * q * de / dd
 
@@ -163,21 +186,52 @@ def _panel(pf, mp, x0, vinf, za, zb, glx, glw):
 
 
 @njit(cache=True)
-def _build_row(pf, mp, x0, vinf, lk, z0, dz, glx, glw, C, j):
-    """ln T and its z-derivatives at the ζ nodes (z = ζ - lk) of row j."""
+def _h_at(pf, mp, x0, vinf, lv, z, e):
+    """:func:`_h` where the caller has e = v∞ e^z (lv = ln v∞): e/σ̄ as one exponential."""
+    lp, lm, de, dl = _pstate(pf, mp, vinf + e)
+    return math.exp(lv + z - lm) / -math.expm1(lp - x0)
+
+
+@njit(cache=True)
+def _lobatto_panel(pf, mp, x0, vinf, lv, za, zb, ea, ha, hb, lbx, lbw, er, full):
+    """∫_{za}^{zb} h dz, one Gauss–Lobatto panel whose end values ha = h(za), hb = h(zb) the
+    caller has (lbx, lbw the rule on [-1, 1], ends included). ``ea`` = v∞ e^za; ``er`` the
+    interior points' e^(z - za) on a panel of the grid's width, used where ``full``."""
+    hw = 0.5 * (zb - za)
+    n = lbx.size
+    acc = lbw[0] * ha + lbw[n - 1] * hb
+    for j in range(1, n - 1):
+        z = za + hw * (1.0 + lbx[j])
+        e = ea * er[j - 1] if full else vinf * math.exp(z)
+        acc += lbw[j] * _h_at(pf, mp, x0, vinf, lv, z, e)
+    return acc * hw
+
+
+@njit(cache=True)
+def _build_row(pf, mp, x0, vinf, lk, z0, dz, lbx, lbw, er, C, j):
+    """ln T and its z-derivatives at the ζ nodes (z = ζ - lk) of row j: T summed downward from
+    the closed-form tail over Gauss–Lobatto panels between the nodes, whose ends take the h
+    each node computes for its derivatives (n - 2 new integrand values a panel; ``er`` their
+    e^(z - z_node) on a full panel, :func:`_lobatto_panel`)."""
     nz = C.shape[1]
+    lv = math.log(vinf)
     z_ext = math.log(mp.v_ext / vinf - 1.0) if mp.v_ext > vinf else -math.inf
     z_prev = z_ext
     T_prev = qk._tail_int(mp.c, mp.v_ext + mp.d, math.inf)
+    h_prev = _h(pf, mp, x0, vinf, z_ext) if z_ext > -math.inf else 0.0
     for k in range(nz - 1, -1, -1):
         z = z0 + k * dz - lk
+        e = vinf * math.exp(z)
+        h, dlnh = _h_dlnh(pf, mp, x0, vinf, e)
         if z >= z_ext:
             T = qk._tail_int(mp.c, vinf * one_plus_exp(z) + mp.d, math.inf)
         else:
-            T = T_prev + _panel(pf, mp, x0, vinf, z, z_prev, glx, glw)
+            full = z_prev < z_ext  # a panel between two nodes (the first one ends at z_ext)
+            T = T_prev + _lobatto_panel(pf, mp, x0, vinf, lv, z, z_prev, e, h, h_prev, lbx,
+                                        lbw, er, full)
             z_prev = z
             T_prev = T
-        h, dlnh = _h_dlnh(pf, mp, x0, vinf, z)
+            h_prev = h
         C[j, k, 0] = math.log(T)
         C[j, k, 1] = -h / T
         C[j, k, 2] = -h * dlnh / T - (h / T) ** 2
@@ -191,31 +245,41 @@ def _lnkappa(pf, mp, vinf):
 
 
 @njit(parallel=True, cache=True)
-def _build_kernel(pf, mp, pr, glx, glw):
-    """Fill the rows of ``pr`` (a :data:`Primitive` with its arrays allocated): per x0 node
-    ln v∞, ln κ, ln T and its z-derivatives at the ζ nodes (C), ln S (the slope below the
-    grid) and the default start's z; ``glx``, ``glw`` the Gauss–Legendre rule of each panel."""
-    # the output arrays as locals, one per statement, outside the loop: a store inside a prange
-    # body into an array taken from a record argument is lost (numba 0.6x parfor lowering)
-    xn = pr.xn
-    C = pr.C
-    lnv = pr.lnv
-    lnS = pr.lnS
-    zs = pr.zs
-    lk = pr.lk
-    z0 = pr.z0
-    dz = pr.dz
+def _rows_kernel(pf, mp, xn, lnv, lk, lnS, zs):
+    """Per x0 node: ln v∞, ln κ, ln S (the slope below the grid) and the default start's z."""
     for j in prange(xn.size):
         x0 = xn[j]
         lv = _plnv(pf, mp, x0)
         vinf = math.exp(lv)
         lnv[j] = lv
         lk[j] = _lnkappa(pf, mp, vinf)
-        _build_row(pf, mp, x0, vinf, lk[j], z0, dz, glx, glw, C, np.int64(j))  # one type
         e, lm, de, dl = _pstate(pf, mp, vinf)
         lnS[j] = lv - math.log(-de) - lm  # S = v∞ |d ln v/d ln π| / σ̄(π0): dT/d(-z) at ū∞
         vs = math.exp(_plnv(pf, mp, x0 + mp.lnp_start))
         zs[j] = math.log(vs / vinf - 1.0)
+
+
+@njit(parallel=True, cache=True)
+def _build_kernel(pf, mp, pr, lbx, lbw, er, rows):
+    """Fill ln T and its z-derivatives at the ζ nodes (C) of the rows of ``pr`` (a
+    :data:`Primitive` with its arrays allocated, ln v∞ and ln κ filled by
+    :func:`_rows_kernel`); ``lbx``, ``lbw`` the Gauss–Lobatto rule of each panel and ``er``
+    its interior points' e^(z - z_node) on the grid's spacing. The rows are visited in the
+    order ``rows`` (:func:`~fastcontact.kernels.balance.spread_order`): a row's cost grows
+    with its z nodes below the closed-form tail, i.e. along x0, and numba gives each thread a
+    contiguous block."""
+    # the output arrays as locals, one per statement, outside the loop: a store inside a prange
+    # body into an array taken from a record argument is lost (numba 0.6x parfor lowering)
+    xn = pr.xn
+    C = pr.C
+    lnv = pr.lnv
+    lk = pr.lk
+    z0 = pr.z0
+    dz = pr.dz
+    for jj in prange(xn.size):
+        j = rows[jj]
+        _build_row(pf, mp, xn[j], math.exp(lnv[j]), lk[j], z0, dz, lbx, lbw, er, C,
+                   np.int64(j))  # one type
 
 
 @njit(parallel=True, cache=True)
@@ -237,18 +301,6 @@ def _check_kernel(pf, mp, pr, xm, zm, glx, glw, err):
             for q in range(m):
                 T += _panel(pf, mp, x0, vinf, z + q * hw, z + (q + 1) * hw, glx, glw)
         err[i] = abs(t_of_z(pr, st, vinf, z) / T - 1.0)
-
-
-@njit(cache=True)
-def _lnkappa_rows_k(pf, mp, xn, out):
-    for j in range(xn.size):
-        out[j] = _lnkappa(pf, mp, math.exp(_plnv(pf, mp, xn[j])))
-
-
-def _lnkappa_rows(pf, mp, xn):
-    out = np.empty(xn.size)
-    _lnkappa_rows_k(pf, mp, xn, out)
-    return out
 
 
 def profile(model, v_lo):
@@ -302,36 +354,41 @@ def _x_nodes(model, dxi):
     return np.ascontiguousarray(np.unique(xn))
 
 
-def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, order=NODE_ORDER, check=True):
+def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, points=None, check=True):
     """Build the primitive of ``model`` (a :class:`~fastcontact.squeeze.model.SqueezeModel`).
 
-    Returns ``(Primitive, info)``; ``info`` holds the grid sizes, build time and the measured
-    maximum relative interpolation error of T at cell centres (``max_rel_err_T``).
+    ``points``: Gauss–Lobatto points per z panel of the node quadrature (None:
+    :func:`node_points` of the model's theory). Returns ``(Primitive, info)``; ``info`` holds
+    the grid sizes, build time and the measured maximum relative interpolation error of T at
+    cell centres (``max_rel_err_T``).
     """
     t0 = _clock.perf_counter()
+    points = node_points(model.theory) if points is None else int(points)
     mp, tab = model.mp, model.tab
     xn = _x_nodes(model, dxi)
     lnv_lo = np.empty(1)
     qk.lnv_of_lnp_kernel(tab, mp, np.array([xn[-1]]), lnv_lo)
     pf = profile(model, math.exp(lnv_lo[0]))
-    lk_max = float(np.max(_lnkappa_rows(pf, mp, xn)))
-    z_hi = math.log(mp.v_ext / math.exp(lnv_lo[0]) - 1.0) + lk_max
-    nz = int(math.ceil((z_hi - z_lo) / dz)) + 2
     nx = xn.size
-    rows = (np.empty(nx) for _ in range(4))  # lnv, lnS, zs, lk
+    lnv, lk, lnS, zs = (np.empty(nx) for _ in range(4))
+    _rows_kernel(pf, mp, xn, lnv, lk, lnS, zs)
+    z_hi = math.log(mp.v_ext / math.exp(lnv_lo[0]) - 1.0) + float(np.max(lk))
+    nz = int(math.ceil((z_hi - z_lo) / dz)) + 2
     pr = Primitive(xn, *_index_map(xn), lagrange_denominators(xn), float(z_lo), float(dz), nz,
-                   np.empty((nx, nz, 3)), *rows, float(mp.v_ext), float(mp.c), float(mp.d))
-    glx, glw = gauss_legendre(order)
-    _build_kernel(pf, mp, pr, glx, glw)
+                   np.empty((nx, nz, 3)), lnv, lnS, zs, lk, float(mp.v_ext), float(mp.c),
+                   float(mp.d))
+    lbx, lbw = gauss_lobatto(points)
+    er = np.exp(0.5 * float(dz) * (1.0 + lbx[1:-1]))
+    _build_kernel(pf, mp, pr, lbx, lbw, er, spread_order(nx))
     pr = readonly_fields(pr)  # written once above; every reader takes it read-only
-    info = {"nx": int(nx), "nz": int(nz), "dxi": float(dxi), "build_seconds":
-            _clock.perf_counter() - t0}
+    info = {"nx": int(nx), "nz": int(nz), "dxi": float(dxi), "node_points": points,
+            "build_seconds": _clock.perf_counter() - t0}
     if check:
         info.update(measure_error(model, pr, pf))
     return pr, info
 
 
-def measure_error(model, pr, pf, n_x=64, order=NODE_ORDER):
+def measure_error(model, pr, pf, n_x=64, order=CHECK_ORDER):
     """Max relative error of the interpolated T at cell centres (n_x x0 cells × all z cells)."""
     rng = np.random.default_rng(0)
     served = int(np.searchsorted(pr.xn, fast_limit(model), side="right")) - 1

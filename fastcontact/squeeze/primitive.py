@@ -16,7 +16,7 @@ fit, π_c/π0 < e^-40) T is the closed form ∫dy/(y³ - c y). The inverse (v at
 bracketed Halley solve on the same interpolant, so forward and inverse agree to rounding and
 ū(t) is monotone.
 
-A primitive is built in one parallel pass (node quadrature, composite Gauss–Legendre in z),
+A primitive is built in one parallel pass (node quadrature, composite Gauss–Lobatto in z),
 and can be written to / read from Parquet with its grid and its measured interpolation error.
 
 This module gathers the names of its three parts: the record and its evaluation
@@ -25,7 +25,7 @@ This module gathers the names of its three parts: the record and its evaluation
 """
 from __future__ import annotations
 
-from ._primitive_build import (DXI, DZ, HZ, NODE_ORDER, X_END, X_FALLBACK, Z_LO,  # noqa: F401
+from ._primitive_build import (DXI, DZ, HZ, NODE_POINTS, X_END, X_FALLBACK, Z_LO,  # noqa: F401
                                PROFILE_DS, PROFILE_FD, Profile, build, fast_limit,
                                measure_error, profile)
 from ._primitive_eval import (Primitive, first_row, row_value, row_value_2,  # noqa: F401
