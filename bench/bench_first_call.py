@@ -51,7 +51,8 @@ for th in ("average", "critical_junction", "emt"):
         t0 = time.perf_counter()
         squeeze_out(T, **kw)
         ts.append(time.perf_counter() - t0)
-    pr, info = prim.build(squeeze_model(Tables.from_parquet(path), th), check=True)
+    T = Tables.from_parquet(path)  # held: the model refers to its tables weakly
+    pr, info = prim.build(squeeze_model(T, th), check=True)
     res[th] = {"ms": 1e3 * float(np.median(ts)), "nx": info["nx"], "nz": info["nz"],
                "err": info["max_rel_err_T"]}
 print(json.dumps(res))
@@ -95,6 +96,15 @@ def main(baseline, pairs):
     write(rows, baseline, pairs, load0, os.getloadavg())
 
 
+def _label(checkout):
+    """``<short commit> (<path>)`` of a checkout (the path alone where git cannot tell)."""
+    import subprocess
+
+    r = subprocess.run(["git", "-C", str(checkout), "rev-parse", "--short", "HEAD"],
+                       capture_output=True, text=True)
+    return f"{r.stdout.strip()} ({checkout})" if r.returncode == 0 else str(checkout)
+
+
 def write(rows, baseline, pairs, load0, load1):
     L = ["## First call on new tables (issue 11.3) — `bench/bench_first_call.py`", "",
          f"Machine: {cpu_model()}, {os.cpu_count()} cores. Load average at start "
@@ -102,8 +112,8 @@ def write(rows, baseline, pairs, load0, load1):
          "",
          "The first `squeeze_out` call on a freshly loaded Tables object (kernels compiled; the "
          "call builds its theory's time primitive), median of 5 calls per process, median over "
-         f"{pairs} fresh processes per checkout, this checkout and the baseline "
-         f"(`{baseline}`) alternating. Error: the primitive's measured maximum relative error "
+         f"{pairs} fresh processes per checkout, this checkout ({_label(HERE.parent)}) and "
+         f"the baseline ({_label(baseline)}) alternating. Error: the primitive's measured maximum relative error "
          "of T at cell centres.", "",
          "| surface | theory | rows × z nodes (before → after) | before [ms] | after [ms] | "
          "after / before | max rel. err of T (before → after) |",
