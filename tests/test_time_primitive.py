@@ -356,3 +356,31 @@ def test_primitive_nodes_vs_reference(T, theory, points=None):
         ref = SqueezeReference(T.surface, E, theory, math.exp(pr.xn[j]) * E)
         t_ref = ref.time(ref.v_inf * (1.0 + math.exp(z[k])), math.inf)
         assert _rel(math.exp(pr.C[j, k, 0]), t_ref) < 3e-7, (j, k, z[k])
+
+
+@pytest.mark.parametrize("theory", ["average", "critical_junction", "emt"])
+def test_profile_slopes_are_the_interpolants_own(T, theory):
+    """The ln v profile's slopes of ln π_c and ln σ̄ (the tables' interpolants differentiated
+    in closed form) against a fourth-order central difference of the interpolated values
+    (step 1e-4 in ln v: truncation ~1e-16, round-off ~1e-12), over the profile's range."""
+    from fastcontact.squeeze import _primitive_build as pb
+
+    m = squeeze_model(T, theory)
+    pf = pb.profile(m, math.exp(float(m.primitive().lnv[-1])))
+    s_end = pf.s0 + (pf.A.shape[0] - 1) * pf.ds
+    s = np.random.default_rng(5).uniform(pf.s0 + 0.01, s_end - 0.01, 300)
+    hh = 1e-4
+    n_exact = 0
+    for si in s:
+        lp, dlp, ls, dls, exact = pb._state_slopes(m.tab, si)
+        if not exact:
+            continue
+        n_exact += 1
+        f = [pb._state_fd(m.tab, si + k * hh) for k in (-2, -1, 1, 2)]
+        for q, d in ((0, dlp), (1, dls)):
+            fd = (f[0][q] - 8.0 * f[1][q] + 8.0 * f[2][q] - f[3][q]) / (12.0 * hh)
+            assert abs(d - fd) <= 1e-7 * max(1.0, abs(fd)), (si, q, d, fd)
+        lp_fd, ls_fd = pb._state_fd(m.tab, si)  # the same values as the tables' lookups
+        assert abs(lp - lp_fd) <= 1e-14 * max(1.0, abs(lp_fd))
+        assert abs(ls - ls_fd) <= 1e-13 * max(1.0, abs(ls_fd))
+    assert n_exact >= 250

@@ -17,7 +17,9 @@ import numpy as np
 from numba import njit, prange
 
 from ..kernels.balance import spread_order
-from ..kernels.hermite import cubic_basis
+from ..kernels.hermite import cubic_basis, quintic_unit
+from ..kernels.locate import locate_asc, locate_desc
+from ..kernels.lookup import sigma_interval_resolved, sigma_linear
 from ..kernels.quadrature import gauss_legendre, gauss_lobatto
 from ..kernels.readonly import readonly_fields
 from . import _kernels as qk
@@ -65,7 +67,8 @@ HZ = 1e-4
 #: x0-independent state along s = ln v (cubic Hermite on a fine uniform grid, below the table
 #: top): ell = ln π_c, lam = ln σ̄ and their s-derivatives; above v_top the analytic tail
 Profile = namedtuple("Profile", "s0 ds A")  # A[i] = (ell, dell, lam, dlam) at s0 + i ds
-#: spacing of the profile grid in ln v and the central-difference step of its derivatives
+#: spacing of the profile grid in ln v and the central-difference step of its derivatives where
+#: the tables' interpolants give none (:func:`_profile_kernel`)
 PROFILE_DS = 0.004
 PROFILE_FD = 1e-5
 
@@ -77,12 +80,51 @@ def _state_fd(tab, s):
     return lp, math.log(qk.k_sigma_of_lnp(tab, lp))
 
 
+@njit(cache=True)
+def _state_slopes(tab, s):
+    """(ln π_c, d ln π_c/ds, ln σ̄, d ln σ̄/ds, exact) of the tables' interpolants at ln v = s:
+    the same values as :func:`_state_fd` and the interpolants' own slopes (the inverse
+    quintic of ln π_c in ln ū; ln σ̄'s quintic, or its line across an unresolved interval, in
+    ln π_c). ``exact`` False beyond the last open node or outside the table (the caller
+    differences :func:`_state_fd` there)."""
+    i = locate_desc(s, tab.lnu, tab.bu_lo, tab.bu_dz, tab.bu_idx)
+    if i < 0:
+        return math.nan, math.nan, math.nan, math.nan, False
+    lnp, lnu, a, d2 = tab.lnp, tab.lnu, tab.dlnu, tab.d2lnu
+    h = lnu[i + 1] - lnu[i]
+    lp, dlp = quintic_unit((s - lnu[i]) / h, h, lnp[i], 1.0 / a[i], -d2[i] / a[i] ** 3,
+                           lnp[i + 1], 1.0 / a[i + 1], -d2[i + 1] / a[i + 1] ** 3)
+    k = locate_asc(lp, lnp, tab.bp_lo, tab.bp_dz, tab.bp_idx)
+    if k < 0 or lp >= tab.lnp_perc or k + 1 >= tab.n_open:
+        return lp, dlp, math.nan, math.nan, False
+    x0, x1 = lnp[k], lnp[k + 1]
+    y0, y1 = tab.lnsig[k], tab.lnsig[k + 1]
+    m0, m1 = tab.dlnsig[k], tab.dlnsig[k + 1]
+    if sigma_interval_resolved(x0, x1, y0, y1, m0, m1):
+        hp = x1 - x0
+        ls, dls = quintic_unit((lp - x0) / hp, hp, y0, m0, tab.d2lnsig[k], y1, m1,
+                               tab.d2lnsig[k + 1])
+    else:
+        ls, dls = sigma_linear(lp, x0, x1, y0, y1), (y1 - y0) / (x1 - x0)
+    return lp, dlp, ls, dls * dlp, True
+
+
 @njit(parallel=True, cache=True)
 def _profile_kernel(tab, s0, ds, A):
+    """The :data:`Profile` samples: values and exact slopes of the tables' interpolants where
+    :func:`_state_slopes` has them (one evaluation a sample), central differences of step
+    PROFILE_FD elsewhere (one-sided at the ends)."""
     n = A.shape[0]
     hh = PROFILE_FD
     for i in prange(n):
         s = s0 + i * ds
+        lp, dlp, ls, dls, exact = _state_slopes(tab, s)
+        if exact:
+            A[i, 0] = lp
+            A[i, 1] = dlp
+            A[i, 2] = ls
+            A[i, 3] = dls
+            continue
         lp, ls = _state_fd(tab, s)
         A[i, 0] = lp
         A[i, 2] = ls
@@ -341,12 +383,19 @@ def fast_limit(model):
     return min(lim, model.x_max)
 
 
+@njit(parallel=True, cache=True)
+def _sigma_samples(tab, xs, out):
+    """σ̄ of the tables at ln π = xs (:func:`~._kernels.sigma_kernel` on the threads)."""
+    for i in prange(xs.size):
+        out[i] = qk.k_sigma_of_lnp(tab, xs[i])
+
+
 def _x_nodes(model, dxi):
     """x0 nodes uniform in ξ = x0 - ln σ̄(x0) on [x_min, x_hi]."""
     x_hi = min(model.x_trap - X_END, _kink(model) - X_END, model.x_max)
     xs = np.linspace(model.x_min, x_hi, 20001)
     sig = np.empty(xs.size)
-    qk.sigma_kernel(model.tab, xs, sig)
+    _sigma_samples(model.tab, xs, sig)
     xi = np.maximum.accumulate(xs - np.log(sig))
     n = max(int(math.ceil((xi[-1] - xi[0]) / dxi)) + 1, 8)
     xn = np.interp(np.linspace(xi[0], xi[-1], n), xi, xs)
