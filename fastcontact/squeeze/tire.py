@@ -60,8 +60,10 @@ __all__ = ["tire_footprint", "tire_history", "tire_columns", "profile_factors",
 PAPER_TIRE = dict(p0=0.2e6, E=10e6, R=0.02, eta=1e-3, rho=1000.0, footprint_length=0.1,
                   speed=30.0, u_start=1e-2)
 
-#: below this many cases the per-case quadrature (~20-40 µs/case) is cheaper than building
-#: the time primitive of a new (tables, theory) (~0.05-0.3 s, once; cached afterwards)
+#: below this many cases the per-case quadrature (~25 µs a case on 2 cores, ~200 µs with three
+#: times; bench/squeeze_results.md) is cheaper than building the time primitive of a new
+#: (tables, theory) (24-49 ms on 2 cores on six spectra, bench/first_call_results.md; once,
+#: cached afterwards)
 QUAD_BELOW = 2_000
 
 
