@@ -384,3 +384,49 @@ def test_profile_slopes_are_the_interpolants_own(T, theory):
         assert abs(lp - lp_fd) <= 1e-14 * max(1.0, abs(lp_fd))
         assert abs(ls - ls_fd) <= 1e-13 * max(1.0, abs(ls_fd))
     assert n_exact >= 250
+
+
+_PATHS = ["squeeze", "tire", "barus squeeze", "barus tire"]
+
+
+@pytest.mark.parametrize("method", ["fast", "quad"])
+@pytest.mark.parametrize("path", _PATHS)
+def test_unrepresentable_tau0_rows_are_flagged_not_fatal(T, path, method):
+    """A row whose τ0 = 3ηR²/(2h²p0) underflows to 0 (R = 1e-300 m) or overflows (R = 1e308 m)
+    in a batch of 2,500 (both methods, every time-at-a-time path: ū at given times, the tire's
+    ū at the exit, with and without a Barus fluid): status "overflow" on that row, and the
+    other rows exactly as in the batch without it. Before 2026-12-02 the τ0 = 0 row raised
+    ZeroDivisionError inside the kernel (SystemError: the whole batch lost; found by
+    bench/bench_fuzz.py), and the Barus engines reported the τ0 = inf row "ok" with inf times."""
+    from fastcontact.tire import tire_footprint
+
+    n = 2500
+    R_ = np.full(n, R)
+    R_[[7, 1500]] = (1e-300, 1e308)
+    p0 = np.geomspace(2e4, 4e5, n)
+
+    def run(Rs, p):
+        kw = dict(p0=p, E_star=E, R=Rs, eta=ETA, theory="critical_junction", method=method)
+        if path.startswith("barus"):
+            kw["alpha_pv"] = 2e-8
+        if path.endswith("squeeze"):
+            return squeeze_out(T, times=(0.0, 1e-6, 1e-3, math.inf), **kw)
+        return tire_footprint(T, footprint_length=0.1, speed=30.0, **kw)
+
+    df = run(R_, p0)
+    assert list(df["status"].iloc[[7, 1500]]) == ["overflow", "overflow"]
+    assert (df["status"].drop(index=[7, 1500]) == "ok").all()
+    keep = np.setdiff1d(np.arange(n), [7, 1500])
+    ref = run(R_[keep], p0[keep])
+    num = [c for c in df.columns if df[c].dtype.kind == "f"]
+    np.testing.assert_array_equal(df[num].to_numpy()[keep], ref[num].to_numpy())
+
+
+def test_study_rows_of_status_overflow_are_explained():
+    from fastcontact.studies.kinds import _below_errors
+
+    err = _below_errors(np.array(["ok", "overflow", "start_below_equilibrium", "overflow"],
+                                 dtype=object), np.array(["", "", "", "out_of_table: x"],
+                                                         dtype=object))
+    assert err[0] == "" and err[1].startswith("overflow: tau0") and err[3] == "out_of_table: x"
+    assert err[2].startswith("start_below_equilibrium")

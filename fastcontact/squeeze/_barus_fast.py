@@ -25,6 +25,7 @@ from ._barus_primitive import (BINOMIALS, K_MAX, BarusTable, s_at, s_cell, s_val
 from ._fastpath import BLOCK, ZTargets, _row_col, _target_time, row_targets, same_targets
 from ._kernels import Cases, Quad
 from ._kernels import _tail_int as qk_tail_int
+from ._kernels import reduced_time
 from ._primitive_eval import (Primitive, inverse_constants_ext, one_plus_exp, row_value,
                               stencil, t_of_z, tail_top)
 from .tire_piezo import _BELOW as TIRE_BELOW
@@ -193,7 +194,7 @@ def _squeeze_block(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, q
             ic = inverse_constants_ext(pr, st, T_ext)
             for k in range(times.size):
                 U_out[k, i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss,
-                                        times[k] / tau, ic) * h
+                                        reduced_time(times[k], tau), ic) * h
 
 
 @njit(parallel=True, cache=True)
@@ -254,8 +255,8 @@ def _tire_block(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb
         if Ts < 0.0:
             Ts = t_of_z(pr, st, vinf, zs)
         ic = inverse_constants_ext(pr, st, T_ext)
-        u_exit[i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss, t_fp[i] / tau,
-                              ic) * h
+        u_exit[i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss,
+                              reduced_time(t_fp[i], tau), ic) * h
 
 
 def ratio_rows(pr, bt, c, tg):

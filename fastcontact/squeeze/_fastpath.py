@@ -412,7 +412,7 @@ def _fast_block(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales, zt, b
                 c = i - b0
                 if scr[c, _LIVE] == 0.0:
                     continue
-                tt = times[k, i if per_case_times else i - i] / scr[c, _TAU]
+                tt = qk.reduced_time(times[k, i if per_case_times else i - i], scr[c, _TAU])
                 ic = (scr[c, _IC], scr[c, _IC + 1], scr[c, _IC + 2], scr[c, _IC + 3],
                       scr[c, _IC + 4])
                 u, Ts = _u_at(pr, _st_of(scr, c), scr[c, _VINF], scr[c, _VS], scr[c, _ZS],
@@ -487,7 +487,7 @@ def _history_block(pr, st, vinf, vs, Ts, ic, tau, h, t, u, k0, k1):
     """Times k0 <= k < k1 of :func:`history_kernel` (the primitive borrowed)."""
     pr = borrowed(pr)
     for k in range(k0, k1):
-        tk = t[k] / tau
+        tk = qk.reduced_time(t[k], tau)
         if tk == 0.0:
             u[k] = vs * h
         elif tk == math.inf:

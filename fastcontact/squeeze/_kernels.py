@@ -294,6 +294,16 @@ def _nan_row(out, i, x_out):
     out.flf[i] = math.nan
 
 
+@njit(cache=True, inline="always")
+def reduced_time(t, tau):
+    """t/τ0 [-] for a time t [s] >= 0 (inf allowed) and τ0 [s]. τ0 = 0 (3ηR²/(2h²p0) below the
+    smallest double, e.g. R = 1e-300 m: the row is flagged "overflow") gives +inf for t > 0
+    and 0 at t = 0 instead of numba's ZeroDivisionError, which aborted the whole batch."""
+    if tau > 0.0:
+        return t / tau
+    return math.inf if t > 0.0 else 0.0
+
+
 @njit(cache=True)
 def _case_state(tab, mp, x0, vs_in, tau, h, i, out):
     """The :data:`Film` of one case; writes the per-case state columns."""
@@ -385,7 +395,7 @@ def _case_times(tab, mp, film, tg, h, quad, i, out):
     wp = math.log(vs - vb) if vs > vb else -math.inf
     col = i if tg.times.shape[1] > 1 else i - i  # same integer type as i
     for k in range(out.U.shape[0]):
-        tk = tg.times[k, col] / tau
+        tk = reduced_time(tg.times[k, col], tau)
         if vs <= vb:
             out.U[k, i] = vs * h
         elif tk == math.inf or (trapped and tk >= t_trap):

@@ -29,10 +29,11 @@ from numba import njit, prange
 
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.readonly import readonly, readonly_fields
-from ._kernels import Cases, Quad
+from ._kernels import Cases, Quad, reduced_time
 from .api import STATUS_NAMES
 from .viscosity import (BarusTargets, _case_head, _case_start, _lnv_of_lnp, _scalars,
-                        _state, _target_times, exit_w, fast_scratch, fast_setup)
+                        _state, _target_times, exit_w, fast_scratch, fast_setup,
+                        flag_overflow)
 
 __all__ = ["QUAD_ORDER", "QUAD_WIDTH", "STATUS", "barus_tire_columns"]
 
@@ -89,7 +90,7 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
     _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
     if t_fp.size:  # no footprint times: the exit is not asked for
         w0 = math.log(vs - vinf)
-        w = exit_w(tab, sc, x0, api, vinf, w0, t_fp[i] / tau, quad)
+        w = exit_w(tab, sc, x0, api, vinf, w0, reduced_time(t_fp[i], tau), quad)
         out.u_exit[i] = (vinf + math.exp(w)) * h
 
 
@@ -166,6 +167,9 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
             _fast_rows(tables, theory, tab, sc, cs, al, tf, h, tg, quad, res)
         else:
             _tire_kernel(tab, sc, cs, al, tf, h, tg, quad, res)
+        with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
+            tau0 = 3.0 * eta * R * R / (2.0 * h * h * p)  # as the kernels' τ0 [s]
+        flag_overflow(st, tau0, T, _OK, _TRAPPED, STATUS.index("overflow"))
     piezo = {"u_inf": ui, "u_start": us, "t_star": T[0], "trapped": st == _TRAPPED,
              "u_trap": ut, "fluid_load_fraction": fl, "out_of_table": st == _OUT}
     if du:

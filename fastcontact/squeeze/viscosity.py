@@ -37,7 +37,7 @@ from .model import squeeze_model
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from ..kernels.readonly import readonly, readonly_fields
-from ._kernels import Cases, Quad, state_gap
+from ._kernels import Cases, Quad, reduced_time, state_gap
 from ._kernels import _lnv_of_lnp as qk_lnv_of_lnp
 from ._kernels import _state as qk_state
 
@@ -50,9 +50,10 @@ __all__ = [
 
 #: default start, as in :func:`fastcontact.squeeze.squeeze_out`: p_cont(u_start) = 1e-3 p0
 DEFAULT_P_START = 1e-3
-ST_OK, ST_TRAPPED, ST_OUT, ST_PIEZO, ST_BELOW = 0, 1, 2, 3, 4
-#: readable ``status`` of each code (ST_*)
-STATUS = ("ok", "trapped", "out_of_table", "piezo_limit", "start_below_equilibrium")
+ST_OK, ST_TRAPPED, ST_OUT, ST_PIEZO, ST_BELOW, ST_OVERFLOW = 0, 1, 2, 3, 4, 5
+#: readable ``status`` of each code (ST_*; "overflow" is set after the kernels,
+#: :func:`flag_overflow`)
+STATUS = ("ok", "trapped", "out_of_table", "piezo_limit", "start_below_equilibrium", "overflow")
 #: the exit search stops this far below ln(ū(0) − ū∞) (ū is then ū∞ to round-off)
 W_SPAN = 60.0
 #: targets shared by all cases: ratios ū/ū∞ (t_star's 1.01 first, then the ratio targets) [-],
@@ -332,7 +333,7 @@ def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
     _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, out.T, i)
     w0 = math.log(vs - vinf)
     for k in range(tg.times.size):
-        tt = tg.times[k] / tau
+        tt = reduced_time(tg.times[k], tau)
         if tt == 0.0:
             out.U[k, i] = vs * h
         else:
@@ -346,6 +347,19 @@ def _piezo_kernel(tab, sc, cs, alpha, h, tg, quad, out):
     (:data:`BarusOut`)."""
     for i in prange(cs.p0.size):  # the index as int64, as the fast path's blocks pass it
         _piezo_case(tab, sc, cs, alpha, h, tg, quad, np.int64(i), out)
+
+
+def flag_overflow(status, tau0, T, st_ok, st_trapped, st_overflow):
+    """Status ``st_overflow`` (in place) on the computed rows whose τ0 [s] or a target time [s]
+    is not representable: τ0 = 3ηR²/(2 h_rms² p0) outside (0, inf) (e.g. R = 1e-300 m or
+    1e308 m: the times are then 0 or inf as numbers, meaningless as results), or an infinite
+    time on an "ok" row (a trapped row's targets below ū_trap are inf by the physics). As the
+    base engine's status "overflow"."""
+    live = (status == st_ok) | (status == st_trapped)
+    bad = live & ~((tau0 > 0.0) & (tau0 < np.inf))
+    if T.size:
+        bad |= (status == st_ok) & np.isinf(T).any(axis=0)
+    status[bad] = st_overflow
 
 
 # =========================================================================== model
@@ -441,8 +455,8 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
         flags ``piezo_limit`` (α(p0 - p_cont) >= 1 at the start: NaN times), ``trapped``
         (p0 beyond the trap pressure: targets below ū_trap take inf), ``out_of_table``,
         ``status`` ("ok", "trapped", "out_of_table", "piezo_limit", "start_below_equilibrium":
-        a given ``u_start`` at or below ū∞, NaN times and rate factor; the other rows are
-        computed).
+        a given ``u_start`` at or below ū∞, NaN times and rate factor; "overflow": τ0 or a
+        time not representable in float64, e.g. R = 1e-300 m; the other rows are computed).
 
     Notes
     -----
@@ -487,6 +501,7 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
         served = _fast_rows(tables, theory, sigma_trap, sc, cs, al, h, tg, quad, out)
     else:
         _piezo_kernel(tables.kernel_data(theory), sc, cs, al, h, tg, quad, out)
+    flag_overflow(status, tau0, T, ST_OK, ST_TRAPPED, ST_OVERFLOW)
     df = _piezo_frame(flat, ratios, du, times, T, U, uinf, ustart, tau0, gs, status, theory,
                       method)
     if method == "fast":

@@ -121,10 +121,17 @@ _BELOW_MESSAGE = ("start_below_equilibrium: u_start <= u_inf (the film starts at
                   "equilibrium separation: nothing to squeeze out)")
 
 
+#: why a squeeze row whose engine status is "overflow" has times of 0 or inf
+_OVERFLOW_MESSAGE = ("overflow: tau0 = 3 eta R^2/(2 h_rms^2 p0) or a time is not representable "
+                     "in float64 (e.g. R = 1e-300 m or 1e308 m): its times are not results")
+
+
 def _below_errors(status, err):
-    """``err`` with the rows of engine status "start_below_equilibrium" explained."""
-    below = np.asarray(status, dtype=object) == "start_below_equilibrium"
-    return np.where(below & (err == ""), _BELOW_MESSAGE, err)
+    """``err`` with the rows of engine status "start_below_equilibrium" and "overflow"
+    explained."""
+    st = np.asarray(status, dtype=object)
+    err = np.where((st == "start_below_equilibrium") & (err == ""), _BELOW_MESSAGE, err)
+    return np.where((st == "overflow") & (err == ""), _OVERFLOW_MESSAGE, err)
 
 
 # =========================================================================== squeeze
