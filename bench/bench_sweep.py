@@ -30,6 +30,13 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 
+
+def _quad_below():
+    """Cases a surface below which squeeze_out takes the per-case quadrature."""
+    from fastcontact.squeeze.tire import QUAD_BELOW
+
+    return QUAD_BELOW
+
 SCENE = """
 title = "bench: tread-block squeeze-out, {n} cases per surface"
 [study]
@@ -186,7 +193,8 @@ def main(argv=None):
         f"per theory; squeeze study, columns u_inf, t_star, 3 ratio times, t_du, trapped). Per "
         f"surface: build its tables with the theories **{', '.join(theories)}**, evaluate all "
         f"cases "
-        f"(`squeeze_out`, per-case quadrature below 50 000 cases), write one Parquet partition "
+        f"(`squeeze_out`, per-case quadrature below {_quad_below():,} cases a surface, "
+        f"`fastcontact.squeeze.tire.QUAD_BELOW`), write one Parquet partition "
         f"atomically. Wall time from `run_sweep` start (LocalCluster start-up included) to the "
         f"last partition; numba caches warmed by a 4-surface sweep first.",
         "",
