@@ -241,7 +241,8 @@ def _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
 def _inertia_columns(b, p_eval, u_used, h_rms, out):
     """``tau_inertia`` τ' = (D²ρ/(64 p_eval))^{1/2} [s] (D = 2R) and ``t_star_inertia``
     τ' ln(ū(0)/h_rms) [s] (NaN where ū(0) is unknown or <= h_rms) into ``out`` — Sec. 5."""
-    tau = inertia_tau(2.0 * b["R"], b["rho"], p_eval)  # inputs validated: n values
+    with np.errstate(over="ignore"):  # R ~ 1e308 m: τ' = inf on a row flagged "overflow"
+        tau = inertia_tau(2.0 * b["R"], b["rho"], p_eval)  # inputs validated: n values
     out["tau_inertia"] = tau
     if u_used is None:
         out["t_star_inertia"] = np.full(p_eval.size, np.nan)
