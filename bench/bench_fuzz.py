@@ -4,8 +4,9 @@ Squeeze-out: the 4 embedded tables x 3 theories, random p0/E* over each table's 
 decade beyond it (plus its edges), E* 1e5-1e11 Pa, R 1 µm-10 m (2 % at 1e308 and 1e-300 m),
 eta 1e-6-1e4 Pa·s; paths: the default fast path (most cases), ``method="quad"`` (also compared
 with the fast path), a given ``u_start`` (above the default start, between the targets, just
-above ū∞, +inf, and 2 % at or below ū∞), ``du`` targets and ``times`` columns, and the exact
-t ∝ eta R² scaling on re-evaluated pairs. Seal: uniform ring over p0 (to 1.5x the percolation
+above ū∞, +inf, and 2 % at or below ū∞), ``du`` targets and ``times`` columns, the exact
+t ∝ eta R² scaling on re-evaluated pairs, and the Barus engines (``squeeze_out`` and
+``tire_footprint`` with ``alpha_pv``, :func:`check_barus`). Seal: uniform ring over p0 (to 1.5x the percolation
 pressure; "average" up to the table top), dp/(p0 - p_b) from 1e-15 to past lift-off, p_b, L,
 L_y, eta, E*, with paired re-evaluations (p0 up, dp up, dp split in two, E*-scaling, the dp -> 0
 limit of eq. 32), and the Hertz O-ring over R, f_N and dp. Every invariant is the function of
@@ -47,7 +48,9 @@ import test_invariants as inv  # noqa: E402
 
 from fastcontact.seal import seal_leak  # noqa: E402
 from fastcontact.squeeze import squeeze_out  # noqa: E402
+from fastcontact._core.vocab import column_name  # noqa: E402
 from fastcontact.tables import Tables  # noqa: E402
+from fastcontact.tire import tire_footprint  # noqa: E402
 
 NAMES = inv.NAMES
 THEORIES = inv.THEORIES
@@ -176,6 +179,20 @@ def squeeze_chunk(tally, tab, name, theory, rng, n, path):
             st = inv._status_bad(df)
             t = df["t_star"].to_numpy(float)
             v["start_below_u_inf_not_status_nan"] = below & ~(st & np.isnan(t))
+        elif path == "barus":
+            # issue 14.2: the Barus engines, squeeze-out and tire, both methods, one fluid or
+            # an α per row (α = 0 on a tenth of the rows: the base primitive's group)
+            method = "quad" if rng.random() < 0.3 else "fast"
+            al = (10 ** rng.uniform(-12, -6.5, n) if rng.random() < 0.5
+                  else np.full(n, 10 ** rng.uniform(-10, -7)))
+            al[rng.random(n) < 0.1] = 0.0
+            df = squeeze_out(tab, theory=theory, ratios=RATIOS, du=du, times=TIMES,
+                             alpha_pv=al, method=method, **kw)
+            ft = tire_footprint(tab, theory=theory, alpha_pv=al, method=method,
+                                footprint_length=rng.uniform(0.01, 0.3, n),
+                                speed=rng.uniform(1.0, 60.0, n), **kw)
+            evals += 2 * n
+            v = check_barus(df, ft)
         else:
             raise ValueError(path)
     except Exception as exc:  # noqa: BLE001 - a crash is a violation of "never crash"
@@ -187,6 +204,47 @@ def squeeze_chunk(tally, tab, name, theory, rng, n, path):
     tally.cases[("squeeze", path)] += len(df)
     tally.evals[("squeeze", path)] += evals
     tally.add("squeeze", path, v, df, inputs)
+
+
+#: status names of the Barus squeeze-out and tire rows
+BARUS_STATUS = {"ok", "trapped", "out_of_table", "piezo_limit", "start_below_equilibrium",
+                "overflow"}
+
+
+def check_barus(df, ft):
+    """Invariants of a Barus squeeze-out frame ``df`` (targets RATIOS, du, TIMES) and tire
+    frame ``ft`` of the same rows: no unknown status; every time >= 0; on "ok" rows every
+    time and ū finite, ū(t) within [ū∞, ū(0)] and non-increasing in t, ū(0) at t = 0 and ū∞
+    at t = inf; the tire's ū at the exit within [ū∞, ū(0)] on its "ok" rows."""
+    v = {}
+    n = len(df)
+    st = df["status"].astype(str).to_numpy()
+    sf = ft["status"].astype(str).to_numpy()
+    v["status_unknown"] = ~np.isin(st, list(BARUS_STATUS)) | ~np.isin(sf, list(BARUS_STATUS))
+    ok = st == "ok"
+    tcols = [c for c in df.columns if c.startswith("t_")]
+    ucols = [column_name("u_at", t) for t in TIMES]
+    T = df[tcols].to_numpy(float)
+    U = df[ucols].to_numpy(float)
+    ui, us = df["u_inf"].to_numpy(float), df["u_start"].to_numpy(float)
+    with np.errstate(invalid="ignore"):
+        v["time_negative"] = (T < 0).any(axis=1) | (ft[[c for c in ft.columns if
+                                                        c.startswith("t_")]].to_numpy(float)
+                                                     < 0).any(axis=1)
+        v["nonfinite_unflagged"] = ok & ~(np.isfinite(T).all(axis=1) & np.isfinite(U).all(axis=1)
+                                          & np.isfinite(ui))
+        band = 1e-12
+        v["u_t_outside_film"] = ok & ((U < ui[:, None] * (1 - band)).any(axis=1)
+                                      | (U > us[:, None] * (1 + band)).any(axis=1))
+        v["u_t_increasing"] = ok & (np.diff(U, axis=1) > band * us[:, None]).any(axis=1)
+        v["u_t0_not_start"] = ok & (U[:, 0] != us)
+        v["u_tinf_not_u_inf"] = ok & (U[:, -1] != ui)
+        okt = sf == "ok"
+        ue, ui_t, us_t = (ft[c].to_numpy(float) for c in ("u_exit", "u_inf", "u_start"))
+        v["tire_exit_outside_film"] = okt & ~((ue >= ui_t * (1 - band))
+                                              & (ue <= us_t * (1 + band)))
+    assert len(v["u_t0_not_start"]) == n
+    return v
 
 
 # =============================================================================== seal
@@ -442,7 +500,8 @@ def run(args):
     combos = [(n, th) for n in NAMES for th in THEORIES]
     t_all = time.perf_counter()
     # squeeze paths
-    fr = dict(quad=args.frac_quad, u_start=args.frac_start, times=args.frac_times)
+    fr = dict(quad=args.frac_quad, u_start=args.frac_start, times=args.frac_times,
+              barus=args.frac_barus)
     fr["fast"] = 1.0 - sum(fr.values())
     for path, f in fr.items():
         total = int(round(args.n_squeeze * f))
@@ -577,6 +636,8 @@ def main(argv=None):
     ap.add_argument("--frac-quad", type=float, default=0.004)
     ap.add_argument("--frac-start", type=float, default=0.006)
     ap.add_argument("--frac-times", type=float, default=0.002)
+    ap.add_argument("--frac-barus", type=float, default=0.002,
+                    help="fraction of squeeze cases through the Barus engines (squeeze + tire)")
     ap.add_argument("--frac-pairs", type=float, default=0.5,
                     help="fraction of seal chunks re-evaluated in pairs (monotonicity etc.)")
     ap.add_argument("--chunk", type=int, default=200_000)
@@ -597,7 +658,7 @@ def main(argv=None):
         args.ref_budget = min(args.ref_budget, 120.0)
         args.n_ref_squeeze = args.n_ref_seal = 12
         args.chunk = min(args.chunk, 20_000)
-        args.frac_quad, args.frac_start, args.frac_times = 0.1, 0.1, 0.05
+        args.frac_quad, args.frac_start, args.frac_times, args.frac_barus = 0.1, 0.1, 0.05, 0.05
     args.n_squeeze, args.n_seal, args.n_hertz = int(args.n_squeeze), int(args.n_seal), int(args.n_hertz)
     res = run(args)
     text = render(args, *res)

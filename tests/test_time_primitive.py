@@ -430,3 +430,36 @@ def test_study_rows_of_status_overflow_are_explained():
                                                          dtype=object))
     assert err[0] == "" and err[1].startswith("overflow: tau0") and err[3] == "out_of_table: x"
     assert err[2].startswith("start_below_equilibrium")
+
+
+@pytest.mark.parametrize("method", ["fast", "quad"])
+def test_barus_rows_at_the_table_top_with_infinite_time(T, method):
+    """Rows at the tables' top pressure (the average theory: σ̄ tiny next to ū∞) asking for ū
+    at t = inf in a Barus batch: ū∞ exactly, and the other rows computed. Before 2026-12-02
+    the quadrature walked W_SPAN panels below ū(0), where σ̄ d g underflowed to 0: numba's
+    ZeroDivisionError, which a lone row raised as SystemError and a batch of 1,667 left as
+    unwritten rows (garbage status codes: found by the Barus path of bench/bench_fuzz.py)."""
+    lo, hi = T.p_range
+    Es = 2e5
+    n = 2000
+    p0 = np.exp(np.random.default_rng(2).uniform(math.log(lo), math.log(hi), n)) * Es
+    p0[[3, 900, 1999]] = (hi * Es, math.exp(np.nextafter(math.log(hi), 0)) * Es,
+                          math.exp(math.log(hi) - 1e-12) * Es)
+    df = squeeze_out(T, p0=p0, E_star=Es, R=0.03, eta=2e-3, alpha_pv=1e-8, theory="average",
+                     ratios=(1.1,), du=(1e-7,), times=(0.0, 1.0, math.inf), method=method)
+    ok = (df["status"] == "ok").to_numpy()
+    assert ok[[3, 900, 1999]].all() and ok.mean() > 0.5
+    u_inf = df["u_inf"].to_numpy()
+    np.testing.assert_array_equal(df[column_name("u_at", math.inf)].to_numpy()[ok], u_inf[ok])
+    assert np.all(np.isfinite(df[column_name("u_at", 1.0)].to_numpy()[ok]))
+
+
+def test_rows_no_kernel_wrote_raise_instead_of_garbage():
+    from fastcontact.squeeze import _kernels as qk
+
+    st = qk.new_status(5)
+    st[[0, 1, 3, 4]] = qk.ST_OK
+    with pytest.raises(RuntimeError, match="1 of 5 rows were not computed .first: row 2."):
+        qk.check_computed(st, "squeeze_out")
+    st[2] = qk.ST_OVERFLOW
+    qk.check_computed(st, "squeeze_out")

@@ -38,6 +38,25 @@ Film = namedtuple("Film", "x0 tau vinf vs vb trapped")
 # status codes (STATUS_NAMES gives the readable value of the ``status`` column)
 ST_OK, ST_TRAPPED, ST_OUT, ST_BELOW, ST_OVERFLOW = 0, 1, 2, 3, 4
 STATUS_NAMES = ("ok", "trapped", "out_of_table", "start_below_equilibrium", "overflow")
+#: status code of a row no kernel has written yet (the status arrays start with it): a kernel
+#: thread that fails inside a parallel loop can stop without raising, leaving its remaining
+#: rows unwritten; :func:`check_computed` turns that into an error instead of garbage rows
+NOT_COMPUTED = -128
+
+
+def check_computed(status, engine):
+    """RuntimeError if a row of ``status`` (int8 codes) still holds NOT_COMPUTED after the
+    kernels of ``engine`` ran (an internal failure, never a property of the inputs)."""
+    bad = np.flatnonzero(status == NOT_COMPUTED)
+    if bad.size:
+        raise RuntimeError(f"{engine}: {bad.size} of {status.size} rows were not computed "
+                           f"(first: row {int(bad[0])}); an internal error of the kernels — "
+                           f"please report it with these inputs")
+
+
+def new_status(n):
+    """A status array of n rows, every one NOT_COMPUTED until a kernel writes it."""
+    return np.full(n, NOT_COMPUTED, dtype=np.int8)
 
 
 def trapped_mask(status, u_trap):

@@ -134,7 +134,7 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad, timescales=True):
             raise ValueError(f"cases: {name} has {size} values, p0 {n} (must be {n} or 1)")
     nt = 1 + ratios.size + dvs.size
     out = qk.SqOut(np.empty((nt, n)), np.empty((times2d.shape[0], n)), *(np.empty(n) for _ in
-                   range(7)), np.empty(n, dtype=np.int8))
+                   range(7)), qk.new_status(n))
     tg = readonly_fields(qk.Targets(np.ascontiguousarray(ratios, dtype=np.float64),
                                     np.ascontiguousarray(dvs, dtype=np.float64),
                                     np.ascontiguousarray(times2d, dtype=np.float64)))
@@ -148,6 +148,7 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad, timescales=True):
         rt = row_targets(pr, tg.ratios, tg.dvs, us[0] / model.h_rms if shared else math.nan)
         fast_kernel(model.tab, model.mp, pr, rt, fast_limit(model), cs, model.h_rms, tg, quad,
                     out, bool(timescales))
+    qk.check_computed(out.status, "squeeze_out")
     if not timescales:  # not written on the rows the fast path serves: nothing to read
         out = out._replace(t_relax=None, t_trap=None, tau0=None)
     return out

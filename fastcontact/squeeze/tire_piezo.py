@@ -29,7 +29,7 @@ from numba import njit, prange
 
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.readonly import readonly, readonly_fields
-from ._kernels import Cases, Quad, reduced_time
+from ._kernels import Cases, Quad, check_computed, new_status, reduced_time
 from .api import STATUS_NAMES
 from .viscosity import (BarusTargets, _case_head, _case_start, _lnv_of_lnp, _scalars,
                         _state, _target_times, exit_w, fast_scratch, fast_setup,
@@ -89,9 +89,12 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
         return
     _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
     if t_fp.size:  # no footprint times: the exit is not asked for
-        w0 = math.log(vs - vinf)
-        w = exit_w(tab, sc, x0, api, vinf, w0, reduced_time(t_fp[i], tau), quad)
-        out.u_exit[i] = (vinf + math.exp(w)) * h
+        tt = reduced_time(t_fp[i], tau)
+        if tt == math.inf:  # τ0 = 0 (a row flagged "overflow" afterwards): ū∞
+            out.u_exit[i] = vinf * h
+        else:
+            w = exit_w(tab, sc, x0, api, vinf, math.log(vs - vinf), tt, quad)
+            out.u_exit[i] = (vinf + math.exp(w)) * h
 
 
 @njit(parallel=True, cache=True)
@@ -152,7 +155,7 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
     dv = np.array([du_complete / h] if du else [])
     T = np.empty((vr.size + dv.size, m))
     ue, ui, us, ut, fl = (np.empty(m) for _ in range(5))
-    st = np.empty(m, dtype=np.int8)
+    st = new_status(m)
     if m:
         us_in = b["u_start"][sel] if "u_start" in b else np.full(m, np.nan)
         x, w = gauss_legendre(QUAD_ORDER)
@@ -169,6 +172,7 @@ def barus_tire_columns(tables, b, p_eval, t_fp, theory, ratios, ratio_names, du_
             _tire_kernel(tab, sc, cs, al, tf, h, tg, quad, res)
         with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
             tau0 = 3.0 * eta * R * R / (2.0 * h * h * p)  # as the kernels' τ0 [s]
+        check_computed(st, "tire_footprint(alpha_pv=...)")
         flag_overflow(st, tau0, T, _OK, _TRAPPED, STATUS.index("overflow"))
     piezo = {"u_inf": ui, "u_start": us, "t_star": T[0], "trapped": st == _TRAPPED,
              "u_trap": ut, "fluid_load_fraction": fl, "out_of_table": st == _OUT}

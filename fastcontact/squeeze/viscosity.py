@@ -37,7 +37,7 @@ from .model import squeeze_model
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from ..kernels.readonly import readonly, readonly_fields
-from ._kernels import Cases, Quad, reduced_time, state_gap
+from ._kernels import Cases, Quad, check_computed, new_status, reduced_time, state_gap
 from ._kernels import _lnv_of_lnp as qk_lnv_of_lnp
 from ._kernels import _state as qk_state
 
@@ -197,14 +197,16 @@ def _case_start(tab, sc, x0, cs, h, i, out):
 
 @njit(cache=True)
 def _integrand(tab, sc, x0, api, vinf, w):
-    """dt̃/dw at w = ln(v - v∞): (v - v∞)/(σ̄ d g(api d)), d = 1 - π_c/π0; 0 if σ̄ = 0."""
+    """dt̃/dw at w = ln(v - v∞): (v - v∞)/(σ̄ d g(api d)), d = 1 - π_c/π0; inf where σ̄ = 0
+    or the denominator underflows (numba raises ZeroDivisionError on x/0)."""
     e = math.exp(w)
     sig, d = state_gap(tab, sc[0], x0, vinf, e)  # as the constant-viscosity quadrature
     if not (sig > 0.0):
         return math.inf
     d = max(1e-300, d)
     g = _rate_factor(api * d) if api > 0.0 else 1.0
-    return e / (sig * d * g)
+    den = sig * d * g  # underflows to 0 where π_c/π0 rounds to 1 next to ū∞ (tiny σ̄)
+    return e / den if den > 0.0 else math.inf
 
 
 @njit(cache=True)
@@ -273,7 +275,7 @@ def exit_w(tab, sc, x0, api, vinf, w0, target, quad):
                 else:
                     hi = y
                 dtdw = _integrand(tab, sc, x0, api, vinf, y)
-                yn = y + f / dtdw if dtdw < math.inf else 0.5 * (lo + hi)
+                yn = y + f / dtdw if 0.0 < dtdw < math.inf else 0.5 * (lo + hi)
                 if not (lo < yn < hi):
                     yn = 0.5 * (lo + hi)
                 if abs(yn - y) <= 1e-14 * max(1.0, abs(y)) or hi - lo <= 1e-14 * max(1.0, abs(y)):
@@ -336,6 +338,8 @@ def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
         tt = reduced_time(tg.times[k], tau)
         if tt == 0.0:
             out.U[k, i] = vs * h
+        elif tt == math.inf:  # ū∞ (as the base engine; no walk of W_SPAN panels)
+            out.U[k, i] = vinf * h
         else:
             out.U[k, i] = (vinf + math.exp(exit_w(tab, sc, x0, api, vinf, w0, tt, quad))) * h
 
@@ -490,7 +494,7 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
     T = np.empty((vr.size + dv.size, n))
     U = np.empty((times.size, n))
     uinf, ustart, tau0, gs = (np.empty(n) for _ in range(4))
-    status = np.empty(n, dtype=np.int8)
+    status = new_status(n)
     x, w = gauss_legendre(qo)
     cs = readonly_fields(Cases(flat[0], flat[1], flat[2], flat[3], flat[5]))
     al = readonly(flat[4])
@@ -501,6 +505,7 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
         served = _fast_rows(tables, theory, sigma_trap, sc, cs, al, h, tg, quad, out)
     else:
         _piezo_kernel(tables.kernel_data(theory), sc, cs, al, h, tg, quad, out)
+    check_computed(status, "squeeze_out(alpha_pv=...)")
     flag_overflow(status, tau0, T, ST_OK, ST_TRAPPED, ST_OVERFLOW)
     df = _piezo_frame(flat, ratios, du, times, T, U, uinf, ustart, tau0, gs, status, theory,
                       method)
