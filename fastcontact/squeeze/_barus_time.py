@@ -312,8 +312,9 @@ def tire_rows(model, bg, cs, t_fp, h, ratios, dvs, quad, res, idx):
             res.u_exit[:] = math.nan
         return
     out = qk.SqOut(np.empty((res.T.shape[0], ng)), np.empty((tg.times.shape[0], ng)),
-                   *(np.empty(ng) for _ in range(7)), np.empty(ng, dtype=np.int8))
+                   *(np.empty(ng) for _ in range(7)), qk.new_status(ng))
     fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, csg, h, tg, quad, out, False)
+    qk.check_computed(out.status, "tire_footprint(alpha_pv=...)")
     res.T[:, idx] = out.T
     res.u_exit[idx] = out.U[0] if t_fp.size else math.nan
     res.u_inf[idx] = out.u_inf
@@ -328,6 +329,8 @@ def run_rest(out, rest, run):
     their last axis) as a call of its own — ``sub(a)`` the rows' read-only copy of a case
     array, ``part`` a fresh record of ``out``'s shape for them — and its part written back."""
     part = type(out)(*(np.empty(a.shape[:-1] + (rest.size,), a.dtype) for a in out))
+    if hasattr(part, "status"):  # unwritten rows stay visible to check_computed
+        part.status[:] = qk.NOT_COMPUTED
     run(lambda a: readonly(np.ascontiguousarray(a[rest])), part)
     for a, b in zip(out, part):
         a[..., rest] = b
@@ -348,7 +351,7 @@ def squeeze_rows(model, bg, cs, tg, h, quad, out, idx):
     csg, tgb, rt = _base_inputs(bg, cs, idx, every, tg.ratios[1:], tg.dvs, tg.times[:, None], h)
     us = csg.us
     times2d = tgb.times
-    code = np.empty(ng, dtype=np.int8)
+    code = qk.new_status(ng)
     if every:
         o = qk.SqOut(out.T, out.U, out.u_inf, out.u_start, np.empty(ng), np.empty(ng),
                      np.empty(ng), np.empty(ng), out.tau0, code)
@@ -358,6 +361,7 @@ def squeeze_rows(model, bg, cs, tg, h, quad, out, idx):
                      *(np.empty(ng) for _ in range(7)), code)
         gs = np.empty(ng)
     fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, csg, h, tgb, quad, o, True)
+    qk.check_computed(code, "squeeze_out(alpha_pv=...)")  # before the codes become statuses
     # the default start is where p_cont = DEFAULT_P_START p0: y there needs no table
     y_default = DEFAULT_P_START if np.isnan(us).all() else -1.0
     status = out.status if every else np.empty(ng, dtype=np.int8)
