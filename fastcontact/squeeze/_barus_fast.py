@@ -185,7 +185,6 @@ def _squeeze_block(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, q
             g_start[i] = math.nan
             continue
         g_start[i] = _rate_factor(A * ds) if A > 0.0 else 1.0
-        status[i] = ST_OK
         Ts = _target_times(bt, pr, sb, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt,
                            T_out, i)
         if times.size:
@@ -195,6 +194,7 @@ def _squeeze_block(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, q
             for k in range(times.size):
                 U_out[k, i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss,
                                         reduced_time(times[k], tau), ic) * h
+        status[i] = ST_OK  # last: a row whose steps above fail keeps NOT_COMPUTED
 
 
 @njit(parallel=True, cache=True)
@@ -246,17 +246,18 @@ def _tire_block(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb
             status[i] = TIRE_BELOW
             continue
         flf[i] = 0.0
-        status[i] = TIRE_OK
         Ts = _target_times(bt, pr, sb, st, E, K, x0, A, vinf, vs, zs, Ts, Ts_row, Ss, tau, zt,
                            T_out, i)
         if t_fp.size == 0:  # the exit is not asked for
             u_exit[i] = math.nan
+            status[i] = TIRE_OK
             continue
         if Ts < 0.0:
             Ts = t_of_z(pr, st, vinf, zs)
         ic = inverse_constants_ext(pr, st, T_ext)
         u_exit[i] = u_at_time(pr, st, bt, c, E, K, x0, A, vinf, vs, Ts, Ss,
                               reduced_time(t_fp[i], tau), ic) * h
+        status[i] = TIRE_OK  # last: a row whose steps above fail keeps NOT_COMPUTED
 
 
 def ratio_rows(pr, bt, c, tg):

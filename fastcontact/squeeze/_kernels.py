@@ -325,7 +325,8 @@ def reduced_time(t, tau):
 
 @njit(cache=True)
 def _case_state(tab, mp, x0, vs_in, tau, h, i, out):
-    """The :data:`Film` of one case; writes the per-case state columns."""
+    """The :data:`Film` of one case; writes the per-case state columns (not the status: the
+    caller writes it last, so that a row whose later steps fail keeps NOT_COMPUTED)."""
     vinf = math.exp(_lnv_of_lnp(tab, mp, x0))
     vs = vs_in
     if vs != vs:  # default start: p_cont(v_start) = DEFAULT_P_START p0
@@ -335,13 +336,11 @@ def _case_state(tab, mp, x0, vs_in, tau, h, i, out):
     out.u_start[i] = vs * h
     if trapped:
         vb = mp.v_trap
-        out.status[i] = ST_TRAPPED
         out.u_trap[i] = vb * h
         out.flf[i] = -math.expm1(mp.x_trap - x0)
         out.t_relax[i] = math.nan
     else:
         vb = vinf
-        out.status[i] = ST_OK
         out.u_trap[i] = math.nan
         out.flf[i] = 0.0
         out.t_relax[i] = tau * vinf * _dlnv_dlnp(tab, mp, x0) / k_sigma_of_lnp(tab, x0)
@@ -441,6 +440,9 @@ def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
         return
     _case_targets(tab, mp, film, tg, quad, i, out)
     _case_times(tab, mp, film, tg, h, quad, i, out)
+    # last: a worker thread that fails above stops without raising, and the row must keep
+    # NOT_COMPUTED for check_computed to see it
+    out.status[i] = ST_TRAPPED if film.trapped else ST_OK
 
 
 @njit(parallel=True, cache=True)

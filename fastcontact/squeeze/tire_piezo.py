@@ -74,11 +74,9 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
     x_trap = sc[0].x_trap
     trapped = x0 >= x_trap
     if trapped:
-        out.status[i] = _TRAPPED
         out.u_trap[i] = math.exp(_lnv_of_lnp(tab, sc, x_trap)) * h
         out.flf[i] = -math.expm1(x_trap - x0)
     else:
-        out.status[i] = _OK
         out.flf[i] = 0.0
     api = alpha[i] * cs.p0[i]
     lnps, _s = _state(tab, sc, vs)
@@ -95,6 +93,8 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
         else:
             w = exit_w(tab, sc, x0, api, vinf, math.log(vs - vinf), tt, quad)
             out.u_exit[i] = (vinf + math.exp(w)) * h
+    # last (a failing worker thread stops without raising: the row keeps NOT_COMPUTED)
+    out.status[i] = _TRAPPED if trapped else _OK
 
 
 @njit(parallel=True, cache=True)

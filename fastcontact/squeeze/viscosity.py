@@ -331,7 +331,6 @@ def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
     if api * d_start >= 1.0:
         _no_times(out, i, np.int64(ST_PIEZO))
         return
-    out.status[i] = ST_TRAPPED if x0 >= sc[0].x_trap else ST_OK
     _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, out.T, i)
     w0 = math.log(vs - vinf)
     for k in range(tg.times.size):
@@ -342,6 +341,8 @@ def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
             out.U[k, i] = vinf * h
         else:
             out.U[k, i] = (vinf + math.exp(exit_w(tab, sc, x0, api, vinf, w0, tt, quad))) * h
+    # last (a failing worker thread stops without raising: the row keeps NOT_COMPUTED)
+    out.status[i] = ST_TRAPPED if x0 >= sc[0].x_trap else ST_OK
 
 
 @njit(parallel=True, cache=True)
