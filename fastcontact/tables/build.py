@@ -221,18 +221,48 @@ def _interval_errors_raw(lnp, cols, mids, theories):
     return err
 
 
-def _sigma_node_derivatives(lnp, cols, theories):
+def _sigma_node_derivatives(lnp, cols, theories, gaps):
     """d ln σ̄/d ln p̄ and its derivative of the critical junction and the effective medium at
     the open nodes (σ̄ > SIGMA_FLOOR), from local polynomials through the nodes
-    (:data:`NODE_STENCIL`)."""
+    (:data:`NODE_STENCIL`) of y = ln σ̄ · (A_c - A(ζ1)/A0) rather than of ln σ̄ itself, then
+    by the chain rule (:func:`_percolation_gap`; ``gaps[theory]`` = (A_c, 1/(2√G(ζ1)))).
+
+    Next to percolation ln σ̄ collapses like -a/(A_c - A(ζ1)/A0) (a ≈ 0.6-1; 2026-11-26 notes
+    in bench/tables_results.md), which a polynomial through nine nodes follows poorly; y tends
+    to -a there and is smooth, so its local polynomial gives the derivatives the quintic
+    Hermite needs, and the refinement needs fewer nodes next to percolation (6 spectra: 8-9 %
+    fewer, bench/tables_results.md, 2026-12-02). The interpolated column is ln σ̄, as before."""
     for th in theories:
         if th not in DERIVED_AT_NODES:
             continue
         s = cols[f"sigma_{th}"]
         ok = s > SIGMA_FLOOR
+        f, f1, f2 = _percolation_gap(lnp, *gaps[th])
+        if not np.all(f[ok] > 0.0):  # (an open node at or past A_c: not expected) plain ln σ̄
+            f, f1, f2 = np.ones_like(lnp), np.zeros_like(lnp), np.zeros_like(lnp)
         with np.errstate(divide="ignore"):
-            cols[f"dlnsigma_{th}"], cols[f"d2lnsigma_{th}"] = local_derivatives(
-                lnp, np.where(ok, np.log(np.where(ok, s, 1)), 0), ok, NODE_STENCIL)
+            L = np.where(ok, np.log(np.where(ok, s, 1)), 0)
+        dy, d2y = local_derivatives(lnp, L * f, ok, NODE_STENCIL)
+        d1 = (dy - L * f1) / f
+        cols[f"dlnsigma_{th}"] = np.where(ok, d1, 0.0)
+        cols[f"d2lnsigma_{th}"] = np.where(ok, (d2y - 2.0 * d1 * f1 - L * f2) / f, 0.0)
+
+
+def _percolation_gap(lnp, a_c, c):
+    """(f, df/d ln p̄, d²f/d(ln p̄)²) of f = A_c - A(ζ1)/A0 = A_c - erf(c p̄) at ln p̄ = lnp
+    (eq. A1 at ζ = ζ1; c = 1/(2√G(ζ1)), G in units of E*²)."""
+    from scipy.special import erf   # as in _assemble: the run path needs no scipy.special
+    z = c * np.exp(lnp)
+    g = (2.0 / math.sqrt(math.pi)) * z * np.exp(-z * z)    # d erf(z)/d ln p̄
+    return a_c - erf(z), -g, -g * (1.0 - 2.0 * z * z)
+
+
+def _gaps(psd, theories, sig_opts):
+    """{theory: (A_c, 1/(2√G(ζ1)))} of the theories whose σ̄ derivatives come from the nodes:
+    the critical junction's a_perc, the effective medium's threshold."""
+    c = 1.0 / (2.0 * math.sqrt(0.25 * math.pi * psd.cum3[-1]))
+    a_c = {"critical_junction": sig_opts["a_perc"], "emt": sig_opts["emt_threshold"]}
+    return {th: (float(a_c[th]), c) for th in theories if th in DERIVED_AT_NODES}
 
 
 def _flag_intervals(lnp, cols, mids, theories, tol):
@@ -259,11 +289,12 @@ def _refine(psd, grid, theories, sig_opts, tol, refine, memory):
     partition; ``memory`` (:class:`~fastcontact.flow.panel_memory.PanelMemory`) collects them."""
     lnp = grid.ln_nodes()
     cols = _exact(psd, np.exp(lnp), theories, sig_opts, memory)
+    gaps = _gaps(psd, theories, sig_opts)
     mid_cache = {}
     rounds = 0
     while True:
         rounds += 1
-        _sigma_node_derivatives(lnp, cols, theories)
+        _sigma_node_derivatives(lnp, cols, theories, gaps)
         xm = 0.5 * (lnp[:-1] + lnp[1:])
         need = np.array([x not in mid_cache for x in xm])
         if np.any(need):
