@@ -15,7 +15,8 @@ d2lnu_dlnp2            d² ln ū / d(ln p̄)² (exact)
 area_fraction          A(ζ1)/A0                                                (A1)
 sigma_<theory>         σ̄ for each requested theory (0 where percolated)        (23)
 dlnsigma_<theory>      d ln σ̄ / d ln p̄ (average: 3 d ln ū/d ln p̄; critical junction and
-                       effective medium: local degree-8 polynomial through 9 nodes)
+                       effective medium: local degree-8 polynomial through 9 nodes of
+                       ln σ̄ (A_c − A(ζ1)/A0), then the chain rule)
 d2lnsigma_<theory>     d² ln σ̄ / d(ln p̄)², likewise
 phi_<theory>           pressure flow factor φ_p = σ̄ (h_rms/ū)³               (Sec. 4)
 percolated_<theory>    True where the contact percolates (σ_eff = 0, fluid trapped)
