@@ -23,6 +23,7 @@ from reference.squeeze_reference import SqueezeReference, flat_stefan_time, tau0
 
 import fastcontact  # noqa: E402
 from fastcontact.squeeze import squeeze_history, squeeze_model, squeeze_out  # noqa: E402
+from fastcontact.squeeze.tire import tire_history  # noqa: E402
 from fastcontact.tables import precompute  # noqa: E402
 from fastcontact._core.vocab import column_name  # noqa: E402
 
@@ -285,6 +286,29 @@ def test_tstar_decreasing_in_p0_in_asymptotic_regime(T):
     pis = np.geomspace(1e-2, 0.3, 10)
     t = squeeze_out(T, p0=pis * E, E_star=E, R=R, eta=ETA, theory="average")["t_star"].to_numpy()
     assert np.all(np.diff(t) > 0)
+
+
+def test_history_of_a_case_without_one_names_the_parameter_its_value_and_range(T):
+    """squeeze_history (and tire_history through it) of a start at or below ū∞, or of a
+    pressure outside the tables: a ValueError with the value and the valid range; ū∞ and the
+    range checked against the tables' own ū(p) and p_range."""
+    import re
+    p0 = 1e5
+    u_inf = float(T.mean_separation(p0, E))
+    with pytest.raises(ValueError) as e:
+        squeeze_history(T, p0, E, R, ETA, "average", t=[0.0, 1.0], u_start=0.5 * u_inf)
+    m = re.search(r"u_start = ([^ ]+) m is invalid for p0 = ([^ ]+) Pa.*must be > u_inf = "
+                  r"([^ ]+) m", str(e.value))
+    assert m and float(m.group(1)) == 0.5 * u_inf and float(m.group(2)) == p0
+    assert abs(float(m.group(3)) / u_inf - 1) < 1e-6
+    lo, hi = T.p_range
+    for pbar in (0.1 * lo, 10.0 * hi):
+        with pytest.raises(ValueError) as e:
+            tire_history(T, p0=pbar * E, E_star=E, R=R, eta=ETA, t=[0.0, 1.0])
+        m = re.search(r"p0 = ([^ ]+) Pa is invalid .* must be in \[([^,]+), ([^\]]+)\]",
+                      str(e.value))
+        assert m and float(m.group(1)) == pbar * E
+        assert abs(float(m.group(2)) / lo - 1) < 1e-5 and abs(float(m.group(3)) / hi - 1) < 1e-5
 
 
 def test_history_columns(T):

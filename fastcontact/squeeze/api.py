@@ -310,6 +310,22 @@ def frame(model, cs, out, ratios, du, times, order, names, method):
     return df
 
 
+def _history_error(row, help_, p0, E_star, u_start, p_range):
+    """The ValueError text of a history whose one case has no history (its squeeze_out status
+    is neither ok nor trapped): the parameter, its value and the valid range where one applies."""
+    st = row["status"]
+    case = f"p0 = {float(p0)!r} Pa, E_star = {float(E_star)!r} Pa"
+    if st == "start_below_equilibrium":
+        return (f"u_start = {u_start!r} m is invalid for {case}: must be > u_inf = "
+                f"{float(row['u_inf'])!r} m (the film must start above its equilibrium "
+                f"separation; status {st!r})")
+    if st == "out_of_table":
+        return (f"p0 = {float(p0)!r} Pa is invalid for E_star = {float(E_star)!r} Pa: p0/E* = "
+                f"{float(p0) / float(E_star):.6g}, must be in [{p_range[0]:.6g}, {p_range[1]:.6g}] "
+                f"(the tables' range; status {st!r})")
+    return f"{case}, u_start = {u_start!r} m are invalid for this case: status {st!r} ({help_[st]})"
+
+
 def squeeze_history(tables, p0, E_star, R, eta, theory=DEFAULT_THEORY, t=None, u_start=None, *,
                     quad_order=16, quad_width=0.5, sigma_trap=None):
     """ū(t), p_cont(t)/p0 and the mean fluid pressure of ONE case on a time array.
@@ -344,8 +360,9 @@ def squeeze_history(tables, p0, E_star, R, eta, theory=DEFAULT_THEORY, t=None, u
                      sigma_trap=sigma_trap)
     row = df.iloc[0]
     if row["status"] != "ok" and row["status"] != "trapped":
-        raise ValueError(f"p0 = {float(p0)!r}, u_start = {u_start!r} are invalid for this case: "
-                         f"status {row['status']!r} ({df.attrs['status'][row['status']]})")
+        mp = squeeze_model(tables, theory, sigma_trap).mp
+        raise ValueError(_history_error(row, df.attrs["status"], p0, E_star, u_start,
+                                        (math.exp(mp.x_min), math.exp(mp.x_max))))
     model = squeeze_model(tables, theory, sigma_trap)
     h = model.h_rms
     x0 = math.log(float(p0) / float(E_star))
