@@ -323,7 +323,12 @@ def test_seal_barus_cells_match_per_row(tables, theory):
     kw = dict(p0=p0, dp=dp, p_b=pb, L=5e-3, L_y=L_Y, E_star=E_STAR, eta=ETA, alpha_pv=al,
               theory=theory)
     got, calls = _table_calls(tables, kw)
-    assert (got.status == "ok").all()
+    # rows whose outlet end reaches the tables' unverified σ̄ next to percolation by enough to
+    # matter are "near_percolation", as the constant-viscosity ring flags them (Q = NaN)
+    base = fc.seal_leak(tables, **{k: v for k, v in kw.items() if k != "alpha_pv"})
+    near = base.status.astype(str).to_numpy() == "near_percolation"
+    assert np.array_equal(got.status.astype(str).to_numpy() == "near_percolation", near)
+    assert (got.status[~near] == "ok").all() and np.isnan(got.Q[near]).all()
     assert len(calls) == 1 and calls[0]["rows"].p0.size >= n - 300  # the shared α's rows
     c = calls[0]
     assert c["bc"].ok.mean() > 0.8  # most partial cells are Legendre sums
@@ -355,7 +360,7 @@ def test_seal_barus_cells_match_per_row(tables, theory):
     ref_all = np.empty(n)
     _uniform_kernel(c["tab"], c["sc"], sub, 0.0, Quad(x, w, 0.05), ref_all)
     q_ref = L_Y * ref_all * float(tables.h_rms) ** 3 / (12.0 * ETA)
-    np.testing.assert_allclose(got.Q.to_numpy(), q_ref, rtol=5e-8, atol=0)
+    np.testing.assert_allclose(got.Q.to_numpy()[~near], q_ref[~near], rtol=5e-8, atol=0)
     for i in np.flatnonzero((frac > 0.1) & (p0 < 0.3 * p_perc))[40:43]:  # separate BVP
         p = p0[i]
         q, _ = seal_bvp(_sigma(tables, theory), lambda xx: p + 0 * xx, 0.0, 5e-3, pb[i] + dp[i],
@@ -363,7 +368,11 @@ def test_seal_barus_cells_match_per_row(tables, theory):
         assert abs(got.Q[i] / (q * L_Y) - 1) < 1e-8
     # weights beyond e^200 over the table: the per-row path, same numbers
     got_big, calls = _table_calls(tables, dict(kw, alpha_pv=np.full(n, 1e-4)))
-    assert not calls and (got_big.status == "ok").all() and np.all(got_big.Q > 0)
+    # (with Q lowered by the weight, the unverified tail's bound matters on more rows: a
+    # superset of the constant-viscosity ring's "near_percolation" rows)
+    st_big = got_big.status.astype(str).to_numpy()
+    assert not calls and set(st_big) <= {"ok", "near_percolation"}
+    assert np.all(st_big[near] == "near_percolation") and np.all(got_big.Q[st_big == "ok"] > 0)
 
 
 def test_seal_barus_tables_kept_across_calls(tables, monkeypatch):

@@ -13,7 +13,11 @@ pressure ("average" is verified everywhere), σ̄ may be off by orders of magnit
 uses the bound 0 <= σ̄ <= σ̄(π_trust) and reports the midpoint when the bound moves Q by less
 than 1e-9 (``_sigma.TAIL_RTOL``), else Q = NaN with status "near_percolation" (e.g. dp << p0
 with p0 − p_b just below the percolation pressure). Hertz and arrays: eq. (33) on adaptive
-Gauss–Legendre panels by damped Newton.
+Gauss–Legendre panels by damped Newton; a profile whose peak contact pressure p_max − p_a lies
+past π_trust is "near_percolation" with Q = NaN (the zone's resistance ∫dx/σ̄ is then
+dominated by the unverified σ̄: no bound on Q but 0 <= Q; such seals are practically closed).
+A profile with p_max − p_a <= π_trust E* < p_max − p_b may still reach it at the peak
+(depending on the fluid pressure there) and is solved as before.
 """
 from __future__ import annotations
 
@@ -129,7 +133,8 @@ def _leak_hertz(sc, theory, R, f_N, com, alpha_cj, o):
     contact = ~(p_a > pH)
     perc = contact & (pH - p_a >= sc.p_perc * E)
     above = contact & ~perc & ((pH - p_b) / E > sc.p_top * (1 + 1e-13))
-    solve = contact & ~perc & ~above & (dp > 0)
+    near = _near_percolation(sc, contact & ~perc & ~above, pH, p_a, E)
+    solve = contact & ~perc & ~above & ~near & (dp > 0)
     idx = np.flatnonzero(solve)
     piH = np.ascontiguousarray(pH / E)
     pia = np.ascontiguousarray(p_a / E)
@@ -155,7 +160,29 @@ def _leak_hertz(sc, theory, R, f_N, com, alpha_cj, o):
             "alpha_cj": alpha, "open_inlet": open_in, "open_outlet": open_out}
     _finish_profile(sc, theory, cols, solve, contact, out, E, a, dp, L_y, eta, alpha)
     _mark_above(cols, above)
+    _mark_near(cols, near & (dp > 0))
     return cols, shape
+
+
+def _near_percolation(sc, live, p_max, p_a, E):
+    """Rows (of ``live``) whose largest contact pressure lies past π_trust, the tables' last
+    verified σ̄ (σ̄ above their floor, just below percolation): the zone's resistance
+    W = ∫dx/σ̄ is then dominated by unverified σ̄ (Q ~ 1e-37 m³/s was reported "ok"), so Q has
+    no verified value. The largest contact pressure p_max - p_f(peak) is at least
+    p_max - p_a (p_f <= p_a): a row flagged here certainly reaches the unverified σ̄; a row
+    with p_max - p_a <= π_trust E* < p_max - p_b may reach it too, depending on p_f at the
+    peak, and is solved as before."""
+    return live & ((p_max - p_a) / E > sc.pi_trust * (1 + 1e-13))
+
+
+def _mark_near(cols, near):
+    """Q = NaN and status "near_percolation" on the rows ``near`` (as the flat ring's rows
+    whose unverified tail could move Q by more than TAIL_RTOL)."""
+    if near.any():
+        cols["Q"] = np.where(near, np.nan, cols["Q"])
+        codes = np.asarray(cols["status"].codes).copy()
+        codes[near] = STATUS.index("near_percolation")
+        cols["status"] = _status(codes)
 
 
 def _mark_above(cols, above):
@@ -178,7 +205,8 @@ def _leak_array(sc, theory, p0x, x, com, alpha_cj, o):
     contact = ~(p_a > pmax)
     perc = contact & ((pmax - p_a >= sc.p_perc * E) | (p0x[-1] - p_b >= sc.p_perc * E))
     above = contact & ~perc & ((pmax - p_b) / E > sc.p_top * (1 + 1e-13))
-    solve = contact & ~perc & ~above & (dp > 0)
+    near = _near_percolation(sc, contact & ~perc & ~above, pmax, p_a, E)
+    solve = contact & ~perc & ~above & ~near & (dp > 0)
     idx = np.flatnonzero(solve)
     out = solve_profile_rows(sc, o, 1, xi, np.ascontiguousarray(p0x, dtype=np.float64),
                               np.ascontiguousarray(1.0 / E), np.ascontiguousarray(p_a / E),
@@ -191,6 +219,7 @@ def _leak_array(sc, theory, p0x, x, com, alpha_cj, o):
             "eta": eta, "alpha_cj": alpha, "open_inlet": xs * L, "open_outlet": (1.0 - xe) * L}
     _finish_profile(sc, theory, cols, solve, contact, out, E, L, dp, L_y, eta, alpha)
     _mark_above(cols, above)
+    _mark_near(cols, near & (dp > 0))
     return cols, shape
 
 

@@ -96,6 +96,22 @@ CHECKED_LEVELS = ((HERTZ_STEPS // 2, HERTZ_STEPS), (FALLBACK_STEPS // 2, FALLBAC
 
 
 # =========================================================================== API
+def _uniform_near_percolation(tables, theory, v, kq, live):
+    """Flat rings whose outlet end reaches past π_trust (p0 - p_b > π_trust E*, the tables'
+    last verified σ̄, just below percolation) by enough to matter: the unverified part of
+    q L = ∫ σ0(p0 - p) w(p) dp over p in [p_b, p_u], p_u = min(p_a, p0 - π_trust E*), lies in
+    [0, σ̄(π_trust)(p_u - p_b)] (w <= 1 for both laws), and a row is "near_percolation" when
+    that bound exceeds TAIL_RTOL (1e-9) of the computed k = 12 η0 q/h³ — the base flat ring's
+    test (:mod:`._leak`), which the Barus/Roelands rings lacked (they reported "ok")."""
+    from ._leak import TAIL_RTOL
+    ctx = seal_context(tables, theory)
+    E = v["E"]
+    p_u = np.minimum(v["pa"], v["g1"] - ctx.pi_trust * E)
+    over = np.maximum(p_u - v["p_b"], 0.0)
+    bound = ctx.rec.sig_trust * over / v["g2"]     # [Pa/m], as kq
+    return live & (v["dp"] > 0) & (over > 0) & (bound > TAIL_RTOL * kq)
+
+
 def _scalars(tables, theory):
     """The record of (tables, theory) the kernels read (a record: it reaches prange bodies).
 
@@ -182,7 +198,9 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         ``percolated``, ``converged`` (Hertz solve), ``out_of_table`` (the largest
         contact pressure lies beyond the tables: Q = NaN), ``status`` ("ok", "lift_off"
         (p_a = max p0: finite limit), "open" (Q = inf), "percolated", "above_table",
-        "not_converged"), and the inputs.
+        "near_percolation" (O-rings whose peak contact pressure p_H - p_a lies past the
+        tables' last verified σ̄, just below percolation: Q = NaN), "not_converged"), and the
+        inputs.
     """
     roelands, shape, v = _piezo_inputs(tables, theory, profile, dp, L_y, E_star, eta, alpha_pv,
                                        p_b, viscosity, roelands_z, p0, L, R, f_N, alpha_cj)
@@ -194,17 +212,20 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
                                    theory)
     else:
         cols, rows = _hertz_rows(tables, theory, tab, sc, v, law, steps)
-    kq, conv, lift, perc, out_t, pmax = rows
+    kq, conv, lift, perc, out_t, pmax, near = rows
+    if profile == "uniform":
+        near = _uniform_near_percolation(tables, theory, v, kq, ~lift & ~perc & ~out_t)
     scale = 1.0
     if theory == "critical_junction":
         scale = (v["alpha_cj"] / float(tables.options.get("alpha_cj", 1.0))) ** 3
     Q = scale * v["L_y"] * kq * float(tables.h_rms) ** 3 / (12.0 * v["eta"])
-    Q = np.where(lift, math.inf, np.where(conv & ~out_t, Q, math.nan))
+    Q = np.where(lift, math.inf, np.where(conv & ~out_t & ~near, Q, math.nan))
     # a NaN row says why before the lift-off equality's flag (its Q is finite when solved)
     from .api import STATUS  # the seal engine's status names (api imports this module)
-    codes = np.select([lift, out_t, perc, ~conv, v["pa"] == pmax],
+    codes = np.select([lift, out_t, perc, near, ~conv, v["pa"] == pmax],
                       [STATUS.index(s) for s in ("open", "above_table", "percolated",
-                                                 "not_converged", "lift_off")],
+                                                 "near_percolation", "not_converged",
+                                                 "lift_off")],
                       STATUS.index("ok")).astype(np.int8)
     status = pd.Categorical.from_codes(codes, categories=list(STATUS))
     cols.update({"p_a": v["pa"], "Q": Q, "lift_off": lift | (v["pa"] == pmax),
@@ -528,7 +549,8 @@ def _uniform_rows(tab, sc, v, law, quad_order, quad_width, memo, theory):
     cols = _base_columns(v)
     cols.update({"p0": p0v, "L": Lv, "open_inlet": np.where(pa > p0v, Lv, 0.0),
                  "open_outlet": np.zeros_like(Lv)})
-    return cols, (kq, np.ones(E.size, dtype=bool), lift, perc, out_t, p0v)
+    return cols, (kq, np.ones(E.size, dtype=bool), lift, perc, out_t, p0v,
+                  np.zeros(E.size, dtype=bool))
 
 
 def _hertz_rows(tables, theory, tab, sc, v, law, steps):
@@ -541,9 +563,13 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
     lift = pa > pH
     perc = (pH - pa >= math.exp(sc[0]["x_perc"]) * E) & ~lift
     out_t = (pH - pb > math.exp(sc[0]["x_hi"]) * E) & ~perc & ~lift
+    # the peak contact pressure certainly past the tables' verified σ̄ (as the base O-ring,
+    # fastcontact.seal.api._near_percolation): no verified Q
+    near = (pH - pa > seal_context(tables, theory).pi_trust * E * (1 + 1e-13)) & ~perc & ~lift \
+        & ~out_t & (v["dp"] > 0)
     kq = np.zeros(E.size)
     conv = np.ones(E.size, dtype=bool)
-    run = ~lift & ~perc & ~out_t & (v["dp"] > 0)
+    run = ~lift & ~perc & ~out_t & ~near & (v["dp"] > 0)
     if np.any(run):
         k = np.empty(int(run.sum()))
         ok = np.empty(int(run.sum()), dtype=np.bool_)
@@ -581,7 +607,7 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
         sb = np.clip(pb / pH, 0.0, 1.0)
         cols["open_inlet"] = np.where(~lift, a * (1.0 - np.sqrt(1.0 - sa * sa)), 2 * a)
         cols["open_outlet"] = np.where(~lift, a * (1.0 - np.sqrt(1.0 - sb * sb)), 0.0)
-    return cols, (kq, conv, lift, perc, out_t, pH)
+    return cols, (kq, conv, lift, perc, out_t, pH, near)
 
 
 def _checked_shooting(shoot, m, levels):
