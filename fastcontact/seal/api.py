@@ -29,8 +29,8 @@ from .._core.vocab import DEFAULT_THEORY
 from . import _panels
 from ._inputs import (alpha_scale, check_tables, check_theory_for, common_inputs, forbid,
                       hertz_contact, profile_kind, require)
-from .context import (EQUALITY_TOL, NEAR_LIFT_OFF, seal_context, solve_profile_rows,
-                      solver_options)
+from .context import (EQUALITY_TOL, NEAR_LIFT_OFF, peak_past_trust, seal_context,
+                      solve_profile_rows, solver_options)
 from ._uniform import leak_uniform
 from .hertz import VERIFY_TOL, table_W
 from .viscosity import seal_leak_piezo  # issue 14: Barus fluid (alpha_pv)
@@ -133,7 +133,7 @@ def _leak_hertz(sc, theory, R, f_N, com, alpha_cj, o):
     contact = ~(p_a > pH)
     perc = contact & (pH - p_a >= sc.p_perc * E)
     above = contact & ~perc & ((pH - p_b) / E > sc.p_top * (1 + 1e-13))
-    near = _near_percolation(sc, contact & ~perc & ~above, pH, p_a, E)
+    near = peak_past_trust(sc.pi_trust, contact & ~perc & ~above & (dp > 0), pH, p_a, E)
     solve = contact & ~perc & ~above & ~near & (dp > 0)
     idx = np.flatnonzero(solve)
     piH = np.ascontiguousarray(pH / E)
@@ -159,39 +159,21 @@ def _leak_hertz(sc, theory, R, f_N, com, alpha_cj, o):
             "p_max": pH, "dp": dp, "p_a": p_a, "p_b": p_b, "L_y": L_y, "E_star": E, "eta": eta,
             "alpha_cj": alpha, "open_inlet": open_in, "open_outlet": open_out}
     _finish_profile(sc, theory, cols, solve, contact, out, E, a, dp, L_y, eta, alpha)
-    _mark_above(cols, above)
-    _mark_near(cols, near & (dp > 0))
+    _mark_nan(cols, above, "above_table", unconverged=True)
+    _mark_nan(cols, near, "near_percolation")
     return cols, shape
 
 
-def _near_percolation(sc, live, p_max, p_a, E):
-    """Rows (of ``live``) whose largest contact pressure lies past π_trust, the tables' last
-    verified σ̄ (σ̄ above their floor, just below percolation): the zone's resistance
-    W = ∫dx/σ̄ is then dominated by unverified σ̄ (Q ~ 1e-37 m³/s was reported "ok"), so Q has
-    no verified value. The largest contact pressure p_max - p_f(peak) is at least
-    p_max - p_a (p_f <= p_a): a row flagged here certainly reaches the unverified σ̄; a row
-    with p_max - p_a <= π_trust E* < p_max - p_b may reach it too, depending on p_f at the
-    peak, and is solved as before."""
-    return live & ((p_max - p_a) / E > sc.pi_trust * (1 + 1e-13))
-
-
-def _mark_near(cols, near):
-    """Q = NaN and status "near_percolation" on the rows ``near`` (as the flat ring's rows
-    whose unverified tail could move Q by more than TAIL_RTOL)."""
-    if near.any():
-        cols["Q"] = np.where(near, np.nan, cols["Q"])
+def _mark_nan(cols, rows, status, unconverged=False):
+    """Q = NaN and ``status`` on ``rows`` ("above_table": the contact pressure above the table,
+    also not converged; "near_percolation": :func:`~.context.peak_past_trust`)."""
+    if rows.any():
+        cols["Q"] = np.where(rows, np.nan, cols["Q"])
         codes = np.asarray(cols["status"].codes).copy()
-        codes[near] = STATUS.index("near_percolation")
+        codes[rows] = STATUS.index(status)
         cols["status"] = _status(codes)
-
-
-def _mark_above(cols, above):
-    if above.any():
-        cols["Q"] = np.where(above, np.nan, cols["Q"])
-        codes = np.asarray(cols["status"].codes).copy()
-        codes[above] = STATUS.index("above_table")
-        cols["status"] = _status(codes)
-        cols["converged"] = cols["converged"] & ~above
+        if unconverged:
+            cols["converged"] = cols["converged"] & ~rows
 
 
 def _leak_array(sc, theory, p0x, x, com, alpha_cj, o):
@@ -205,7 +187,7 @@ def _leak_array(sc, theory, p0x, x, com, alpha_cj, o):
     contact = ~(p_a > pmax)
     perc = contact & ((pmax - p_a >= sc.p_perc * E) | (p0x[-1] - p_b >= sc.p_perc * E))
     above = contact & ~perc & ((pmax - p_b) / E > sc.p_top * (1 + 1e-13))
-    near = _near_percolation(sc, contact & ~perc & ~above, pmax, p_a, E)
+    near = peak_past_trust(sc.pi_trust, contact & ~perc & ~above & (dp > 0), pmax, p_a, E)
     solve = contact & ~perc & ~above & ~near & (dp > 0)
     idx = np.flatnonzero(solve)
     out = solve_profile_rows(sc, o, 1, xi, np.ascontiguousarray(p0x, dtype=np.float64),
@@ -218,8 +200,8 @@ def _leak_array(sc, theory, p0x, x, com, alpha_cj, o):
             "L": np.full(E.size, L), "dp": dp, "p_a": p_a, "p_b": p_b, "L_y": L_y, "E_star": E,
             "eta": eta, "alpha_cj": alpha, "open_inlet": xs * L, "open_outlet": (1.0 - xe) * L}
     _finish_profile(sc, theory, cols, solve, contact, out, E, L, dp, L_y, eta, alpha)
-    _mark_above(cols, above)
-    _mark_near(cols, near & (dp > 0))
+    _mark_nan(cols, above, "above_table", unconverged=True)
+    _mark_nan(cols, near, "near_percolation")
     return cols, shape
 
 

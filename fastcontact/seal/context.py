@@ -20,7 +20,8 @@ from . import _panels, _sigma
 
 __all__ = ["SealRecord", "SealContext", "seal_context", "PanelRule", "RowsOut", "panel_rule",
            "solver_options", "SOLVER_DEFAULTS", "RETAB_H", "RETAB_TOL", "PRIM_H", "PRIM_GL",
-           "PRIM_DEPTH", "TAIL_SPLIT", "NEAR_LIFT_OFF", "EQUALITY_TOL", "solve_profile_rows"]
+           "PRIM_DEPTH", "TAIL_SPLIT", "NEAR_LIFT_OFF", "EQUALITY_TOL", "solve_profile_rows",
+           "peak_past_trust"]
 
 #: re-tabulation of ln σ̄ (uniform in ln π): spacing and per-cell verification tolerance
 RETAB_H = 1.0 / 64.0
@@ -236,6 +237,18 @@ class SealContext:
 
 
 _CONTEXTS = PerObjectCache()
+
+
+def peak_past_trust(pi_trust, live, p_max, p_a, E):
+    """Profile rows (of ``live``) whose largest contact pressure lies past ``pi_trust`` (the
+    reduced pressure of the tables' last verified σ̄: σ̄ above their floor, just below
+    percolation): the zone's resistance W = ∫dx/σ̄ is then dominated by unverified σ̄, so Q has
+    no verified value ("near_percolation"). The largest contact pressure p_max - p_f(peak) is at
+    least p_max - p_a (p_f <= p_a): a row flagged here certainly reaches the unverified σ̄; a
+    row with p_max - p_a <= π_trust E* < p_max - p_b may reach it too, depending on p_f at the
+    peak, and is solved as before. Used by the base, Barus and Roelands O-rings and the
+    sampled profiles."""
+    return live & ((p_max - p_a) / E > pi_trust * (1 + 1e-13))
 
 
 def seal_context(tables, theory) -> SealContext:

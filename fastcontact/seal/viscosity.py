@@ -61,8 +61,8 @@ from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from ..kernels.readonly import readonly_fields
 from . import _panels
-from .context import (NEAR_LIFT_OFF, new_runs, seal_context, solve_profile_rows,
-                      solver_options)
+from .context import (NEAR_LIFT_OFF, new_runs, peak_past_trust, seal_context,
+                      solve_profile_rows, solver_options)
 from ._piezo_kernels import (TAIL_CUT, HertzRows, Quad, RingCells, UniformRows, _cells_kernel,
                              _cells_rows, _hertz_kernel, _hertz_kernel_r, _uniform_sweep_kernel)
 from ._roelands_psi import psi_drops
@@ -563,10 +563,8 @@ def _hertz_rows(tables, theory, tab, sc, v, law, steps):
     lift = pa > pH
     perc = (pH - pa >= math.exp(sc[0]["x_perc"]) * E) & ~lift
     out_t = (pH - pb > math.exp(sc[0]["x_hi"]) * E) & ~perc & ~lift
-    # the peak contact pressure certainly past the tables' verified σ̄ (as the base O-ring,
-    # fastcontact.seal.api._near_percolation): no verified Q
-    near = (pH - pa > seal_context(tables, theory).pi_trust * E * (1 + 1e-13)) & ~perc & ~lift \
-        & ~out_t & (v["dp"] > 0)
+    near = peak_past_trust(seal_context(tables, theory).pi_trust,
+                           ~perc & ~lift & ~out_t & (v["dp"] > 0), pH, pa, E)
     kq = np.zeros(E.size)
     conv = np.ones(E.size, dtype=bool)
     run = ~lift & ~perc & ~out_t & ~near & (v["dp"] > 0)

@@ -359,11 +359,10 @@ def squeeze_history(tables, p0, E_star, R, eta, theory=DEFAULT_THEORY, t=None, u
                      u_start=u_start, ratios=(), quad_order=quad_order, quad_width=quad_width,
                      sigma_trap=sigma_trap)
     row = df.iloc[0]
-    if row["status"] != "ok" and row["status"] != "trapped":
-        mp = squeeze_model(tables, theory, sigma_trap).mp
-        raise ValueError(_history_error(row, df.attrs["status"], p0, E_star, u_start,
-                                        (math.exp(mp.x_min), math.exp(mp.x_max))))
     model = squeeze_model(tables, theory, sigma_trap)
+    if row["status"] != "ok" and row["status"] != "trapped":
+        raise ValueError(_history_error(row, df.attrs["status"], p0, E_star, u_start,
+                                        (math.exp(model.mp.x_min), math.exp(model.mp.x_max))))
     h = model.h_rms
     x0 = math.log(float(p0) / float(E_star))
     u = np.empty(t.size)
