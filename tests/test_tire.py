@@ -70,6 +70,18 @@ def test_history_matches_squeeze_history(T):
     assert a.attrs["units"]["du"] == "m"
 
 
+def test_history_at_infinite_time_is_equilibrium(T):
+    """t = +inf is allowed (as in squeeze_history) and gives ū∞ itself; t = 0 the start."""
+    t = np.array([1e-7, np.inf, 0.0])
+    a = tire_history(T, p0=0.2e6, E_star=E, R=0.02, eta=1e-3, t=t, theory="average")
+    b = squeeze_history(T, 0.2e6, E, 0.02, 1e-3, "average", t=t, u_start=1e-2)
+    np.testing.assert_array_equal(a["u"], b["u"])
+    assert a["u"].iloc[1] == a["u_inf"].iloc[1] and a["du"].iloc[1] == 0.0
+    assert a["u"].iloc[2] == 1e-2 and a["u"].iloc[0] > a["u_inf"].iloc[0]
+    with pytest.raises(ValueError, match="t"):
+        tire_history(T, p0=0.2e6, E_star=E, R=0.02, eta=1e-3, t=[np.nan], theory="average")
+
+
 @pytest.mark.parametrize("method", ["fast", "quad"])
 def test_columns_select_what_the_kernel_computes(T, method, monkeypatch):
     """A study asking for some columns gets them equal to the full call's, and the engine

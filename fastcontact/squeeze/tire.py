@@ -369,14 +369,15 @@ def tire_history(tables, *, p0, E_star, R, eta, t, theory=DEFAULT_THEORY,
     tables, p0, E_star, R, eta, theory, u_start
         As :func:`tire_footprint`, scalars.
     t : array_like
-        Times [s] ≥ 0.
+        Times [s] ≥ 0, any order; +inf gives ū∞ (as :func:`squeeze_history`).
 
     Returns
     -------
     pandas.DataFrame
         ``t`` [s], ``u`` [m], ``du`` = ū - ū∞ [m], ``u_inf`` [m]; ``attrs`` with units.
     """
-    t = np.ascontiguousarray(check_positive("t", t, "[s]", allow_zero=True).ravel())
+    t = np.ascontiguousarray(np.atleast_1d(check_positive("t", t, "[s]", allow_zero=True,
+                                                          allow_inf=True)).ravel())
     one = squeeze_out(tables, p0=p0, E_star=E_star, R=R, eta=eta, theory=theory,
                       u_start=u_start, ratios=())
     row = one.iloc[0]
