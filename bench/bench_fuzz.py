@@ -14,7 +14,8 @@ limit of eq. 32), and the Hertz O-ring over R, f_N and dp. Every invariant is th
 
 Accuracy: the worst relative error against the independent references
 (``tests/reference/squeeze_reference.py``, ``tests/reference/seal_reference.py``: the direct
-contact core + scipy quad, no tables) on a random subsample.
+contact core + scipy quad, no tables) on a random subsample, and of the Barus squeeze-out
+against ``tests/reference/ext_reynolds.py`` (the radial Reynolds equation with η(p)).
 
 Memory is bounded: cases are generated, evaluated and checked in chunks (``--chunk``); only
 counters are kept. Results go to a ``--label`` section of ``bench/fuzz_results.md``.
@@ -357,6 +358,16 @@ def seal_hertz_chunk(tally, tab, name, theory, rng, n):
 
 
 # =============================================================================== references
+def _ref_draws(n_ref, budget):
+    """(k, theory, table name) of the reference draws: the 3 theories × 4 tables in turn, at
+    most ``n_ref`` of them, until ``budget`` seconds have passed."""
+    t_end = time.perf_counter() + budget
+    k = 0
+    while k < n_ref and time.perf_counter() < t_end:
+        yield k, THEORIES[k % 3], NAMES[(k // 3) % 4]
+        k += 1
+
+
 def squeeze_refs(tables, rng, n_ref, budget):
     """Worst relative error of t_ratio_1.1 / t_ratio_1.01 (fast path, default and given
     start) against SqueezeReference (direct core + scipy quad)."""
@@ -364,12 +375,7 @@ def squeeze_refs(tables, rng, n_ref, budget):
     from fastcontact.tables.defaults import default_surface
     worst = {}
     done = Counter()
-    t_end = time.perf_counter() + budget
-    k = 0
-    while k < n_ref and time.perf_counter() < t_end:
-        theory = THEORIES[k % 3]
-        name = NAMES[(k // 3) % 4]
-        k += 1
+    for _k, theory, name in _ref_draws(n_ref, budget):
         tab = tables[name]
         lo, hi = tab.p_range
         top = min(hi, 0.9 * tab.percolation_pressure(theory, 1.0))
@@ -409,6 +415,70 @@ def squeeze_refs(tables, rng, n_ref, budget):
     return worst, done
 
 
+#: rows of a Barus reference call that shares α E* (the one-fluid time primitive serves a group
+#: of at least this many rows, fastcontact/squeeze/_barus_time.py MIN_GROUP_ROWS)
+BARUS_GROUP = 20_000
+
+
+def barus_refs(tables, rng, n_ref, budget):
+    """Worst relative error of the Barus squeeze-out's t_ratio_1.1 from the default start
+    (or, where that lies above the tables, 0.9 of their top separation; method="fast")
+    against the radial Reynolds equation with η(p) integrated directly
+    (``tests/reference/ext_reynolds.py``: solve_ivp + brentq + quad, no reduced pressure),
+    α p0 log-uniform in [1e-4, 0.6]: alternately a row of its own α (the per-case kernel) and
+    a row among BARUS_GROUP sharing α E* (the one-fluid time primitive)."""
+    from reference.ext_reynolds import squeeze_time
+    worst = {}
+    done = Counter()
+    for k, theory, name in _ref_draws(n_ref, budget):
+        group = (k // 12) % 2 == 1
+        tab = tables[name]
+        lo, hi = tab.p_range
+        top = min(hi, 0.9 * tab.percolation_pressure(theory, 1.0))
+        E = 10 ** rng.uniform(6, 8)
+        pbar = math.exp(rng.uniform(math.log(lo) + 1.0, math.log(top)))
+        p0 = pbar * E
+        R, eta = 10 ** rng.uniform(-3, -1), 10 ** rng.uniform(-4, 0)
+        alpha = 10 ** rng.uniform(-4, math.log10(0.6)) / p0
+        path = "barus, one fluid" if group else "barus, alpha per row"
+        try:
+            # a group shares α E* (its G primitive); otherwise a second row of another α
+            # keeps both in the per-case kernel (a call of one fluid always builds its G)
+            n = BARUS_GROUP if group else 2
+            p0s = p0 * np.exp(rng.uniform(-0.5, 0.0, n))
+            p0s[0] = p0
+            al = alpha if group else np.array([alpha, 0.5 * alpha])
+            # the reference reads the tables' p_cont(ū): a start inside them (the default
+            # start where it is, else 0.9 of the tables' top separation if that is above 1.2 ū∞)
+            base = squeeze_out(tab, p0=p0, E_star=E, R=R, eta=eta, theory=theory, ratios=())
+            u_top = 0.9 * tab.u_range[1] * tab.h_rms
+            us = None if float(base["u_start"].iloc[0]) < u_top else u_top
+            if us is not None and us < 1.2 * float(base["u_inf"].iloc[0]):
+                continue
+            df = squeeze_out(tab, p0=p0s, E_star=E, R=R, eta=eta, theory=theory,
+                             alpha_pv=al, ratios=(1.1,), u_start=us, method="fast")
+            r = df.iloc[0]
+            served = sum(g["cases_served"] for g in df.attrs.get("barus_time_primitive") or ()
+                         if g["primitive"] == "Barus G")
+            if served != (n if group else 0):  # the path this draw is about
+                raise RuntimeError(f"{served} of {n} rows on a G primitive ({path})")
+            if r["status"] != "ok":
+                continue
+            want = squeeze_time(tab, theory, p0, E, R, eta, alpha, float(r["u_start"]),
+                                1.1 * float(r["u_inf"]), float(r["u_inf"]), rtol=1e-10)
+            got = float(r["t_ratio_1.1"])
+            e = abs(got / want - 1) if want > 0 else abs(got)
+            key = (theory, path)
+            if e > worst.get(key, (-1,))[0]:
+                worst[key] = (e, dict(table=name, p0=p0, E_star=E, alpha_p0=alpha * p0,
+                                      got=got, ref=want))
+            done[key] += 1
+        except Exception as exc:  # noqa: BLE001
+            worst[(theory, "barus error")] = (math.inf, dict(table=name, p0=p0,
+                                                             error=str(exc)[:200]))
+    return worst, done
+
+
 def uniform_ref_exact_width(psd, *, p0, dp, L, L_y, E_star, eta, theory, p_b=0.0):
     """Q of a flat ring with the interval [c - dp, c], c = p0 - p_b, of exact width dp.
 
@@ -435,13 +505,8 @@ def seal_refs(tables, rng, n_ref, budget):
     from fastcontact.tables.defaults import default_surface
     worst = {}
     done = Counter()
-    t_end = time.perf_counter() + budget
-    k = 0
-    while k < n_ref and time.perf_counter() < t_end:
-        theory = THEORIES[k % 3]
-        name = NAMES[(k // 3) % 4]
+    for k, theory, name in _ref_draws(n_ref, budget):
         hertz = k % 5 == 4 and theory != "emt"
-        k += 1
         tab = tables[name]
         lo, hi = tab.p_range
         top = min(0.999 * hi, 0.999 * tab.percolation_pressure(theory, 1.0))
@@ -537,8 +602,9 @@ def run(args):
     t0 = time.perf_counter()
     sq_ref = squeeze_refs(tables, rng, args.n_ref_squeeze, args.ref_budget)
     se_ref = seal_refs(tables, rng, args.n_ref_seal, args.ref_budget)
+    ba_ref = barus_refs(tables, rng, args.n_ref_barus, args.ref_budget)
     t_ref = time.perf_counter() - t0
-    return tally, sq_ref, se_ref, t_fuzz, t_ref
+    return tally, sq_ref, se_ref, ba_ref, t_fuzz, t_ref
 
 
 def _fmt(x):
@@ -547,7 +613,7 @@ def _fmt(x):
     return str(x)
 
 
-def render(args, tally, sq_ref, se_ref, t_fuzz, t_ref):
+def render(args, tally, sq_ref, se_ref, ba_ref, t_fuzz, t_ref):
     L = [f"## {args.label}", ""]
     import fastcontact
     L.append(f"Run {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; {machine()}; "
@@ -595,11 +661,11 @@ def render(args, tally, sq_ref, se_ref, t_fuzz, t_ref):
         e, info = worst[key]
         L.append(f"| squeeze | {key[0]} | {key[1]} | {done[key[0]]} | {e:.2e} | "
                  f"{', '.join(f'{k}={_fmt(v)}' for k, v in info.items())} |")
-    worst, done = se_ref
-    for key in sorted(worst):
-        e, info = worst[key]
-        L.append(f"| seal | {key[0]} | {key[1]} | {done[key]} | {e:.2e} | "
-                 f"{', '.join(f'{k}={_fmt(v)}' for k, v in info.items())} |")
+    for eng, (worst, done) in (("seal", se_ref), ("squeeze", ba_ref)):
+        for key in sorted(worst):
+            e, info = worst[key]
+            L.append(f"| {eng} | {key[0]} | {key[1]} | {done[key]} | {e:.2e} | "
+                     f"{', '.join(f'{k}={_fmt(v)}' for k, v in info.items())} |")
     L.append("")
     return "\n".join(L)
 
@@ -643,6 +709,8 @@ def main(argv=None):
     ap.add_argument("--chunk", type=int, default=200_000)
     ap.add_argument("--n-ref-squeeze", type=int, default=60)
     ap.add_argument("--n-ref-seal", type=int, default=60)
+    ap.add_argument("--n-ref-barus", type=int, default=24,
+                    help="Barus squeeze-out references (radial Reynolds with η(p))")
     ap.add_argument("--ref-budget", type=float, default=600.0, help="seconds per reference set")
     ap.add_argument("--seed", type=int, default=20261123)
     ap.add_argument("--label", default="run")
@@ -656,7 +724,7 @@ def main(argv=None):
         args.n_squeeze, args.n_seal, args.n_hertz = 1e5, 1e5, 600
         args.hertz_budget = min(args.hertz_budget, 60.0)
         args.ref_budget = min(args.ref_budget, 120.0)
-        args.n_ref_squeeze = args.n_ref_seal = 12
+        args.n_ref_squeeze = args.n_ref_seal = args.n_ref_barus = 12
         args.chunk = min(args.chunk, 20_000)
         args.frac_quad, args.frac_start, args.frac_times, args.frac_barus = 0.1, 0.1, 0.05, 0.05
     args.n_squeeze, args.n_seal, args.n_hertz = int(args.n_squeeze), int(args.n_seal), int(args.n_hertz)

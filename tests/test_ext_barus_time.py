@@ -94,6 +94,55 @@ def test_primitive_against_base_plus_correction(tables, theory):
     assert np.any(x0s > math.log(0.5 / (alpha * E_STAR)))     # α p0 up to 0.6 covered
 
 
+def _widest_rows(tables, theory):
+    """(x0 of the base primitive's widest-spaced row interval below the fast limit and above
+    the tables' bottom, its width)."""
+    pr, _bt, _c, xf = fast_setup(tables, theory, None)
+    xn, d = pr.xn, np.diff(pr.xn)
+    inside = (xn[1:] <= xf) & (xn[:-1] > squeeze_model(tables, theory).mp.x_min + 1.0)
+    j = int(np.argmax(np.where(inside, d, 0.0)))
+    return float(xn[j]), float(d[j])
+
+
+@pytest.mark.parametrize("theory", ["critical_junction", "emt"])
+def test_primitive_where_the_rows_are_widest(tables, theory):
+    """Where the base rows are widest in x0 (low p0/E*, ~0.09) and A = α p0 reaches 0.6, G's
+    x0-dependence through A ∝ e^x0 made the 4-point row interpolation err by 2e-6 (the base T
+    there: ~1e-9); the G primitive inserts rows there (interpolated T, exact A S): G within
+    2e-8 of T + A S on random (x0, z) in the two units of x0 below its limit."""
+    x, dx = _widest_rows(tables, theory)
+    assert dx > 0.08                                    # the case this test is about
+    aE = 0.6 / math.exp(x + 0.5 * dx)
+    pr, bt, c, _xf = fast_setup(tables, theory, None)
+    bg, idx, _rest = _served(tables, theory, [math.exp(x) * E_STAR], aE / E_STAR, 10.0)
+    assert idx.size == 1 and bg.pr.xn.size > np.count_nonzero(pr.xn <= bg.pr.xn[-1])
+    rng = np.random.default_rng(3)
+    n = 20000
+    x0s = rng.uniform(max(pr.xn[0], bg.x_served - 2.0), bg.x_served, n)
+    zs = rng.uniform(-14.0, bg.z_top - 0.5 - float(np.max(pr.lk)), n)
+    out = np.empty((n, 2))
+    _g_both(pr, bg.pr, bt, c, aE, x0s, zs, out)
+    assert np.all(np.isfinite(out)) and np.max(np.abs(out[:, 0] / out[:, 1] - 1.0)) < 2e-8
+
+
+def test_one_fluid_at_widely_spaced_rows_against_reynolds_reference():
+    """The embedded road tables' critical junction at p0/E* = 4.6e-8 (rows 0.083 apart) and
+    α p0 = 0.596, one fluid (the G primitive): t(1.1 ū∞) from the default start within 1e-7 of
+    the Reynolds reference (was 1.0e-6 off before the G primitive refined its rows there)."""
+    from fastcontact.tables.defaults import default_table_path
+    T = fc.Tables.from_parquet(default_table_path("asphalt_024mm"))
+    E, pbar = 5844370.791008395, 4.623041479785134e-08
+    p0 = pbar * E
+    alpha = 0.5957149352435938 / p0
+    df = fc.squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, theory="critical_junction",
+                        alpha_pv=alpha, ratios=(1.1,), method="fast")
+    r = df.iloc[0]
+    assert r.status == "ok" and df.attrs["barus_time_primitive"][0]["primitive"] == "Barus G"
+    ref = squeeze_time(T, "critical_junction", p0, E, R, ETA, alpha, r.u_start, 1.1 * r.u_inf,
+                       r.u_inf, rtol=1e-11)
+    assert abs(r["t_ratio_1.1"] / ref - 1) < 1e-7
+
+
 def test_one_fluid_tire_against_reynolds_reference(tables):
     """A call of one α and one E*: every row from the G primitive; the times to the targets
     and ū at the footprint exit (the reference time from ū(0) to it is the footprint time)

@@ -8,8 +8,9 @@ T the constant-viscosity time primitive (:mod:`.primitive`) and S the Barus corr
 :mod:`._barus_primitive`. Where every case of a call shares α and E* (one oil or water, one
 tread compound: the usual tire or road study; or the rows of one α E* in a call of several,
 :func:`served_groups`), A is a function of x0 = ln(p0/E*) alone, so G is a function of (x0, z)
-as T is: it is tabulated here on the base primitive's own rows and z
-nodes, as ln G with its first two z-derivatives (exact at the nodes),
+as T is: it is tabulated here on the base primitive's rows (with rows inserted where they are
+too far apart for G's x0-dependence through A, :data:`DX_G`) and z nodes, as ln G with its first
+two z-derivatives (exact at the nodes),
 
     dG/dz   = T'/g(a),                     a = A (1 - y),  y = π_c(v)/π0,
     d²G/dz² = T''/g(a) - T' A (1/g)'(a) dy/dz,   dy/dz = y (d ln π_c/d ln v)(v - v∞)/v,
@@ -45,7 +46,8 @@ from ..kernels.readonly import readonly, readonly_fields
 from . import _kernels as qk
 from ._barus_primitive import API_FAST, K_MAX, s_at, s_cell, series_order, shift
 from ._fastpath import fast_kernel, row_targets
-from ._primitive_eval import Primitive, _index_map, _locate, lagrange_denominators
+from ._primitive_eval import (Primitive, _index_map, _locate, lagrange_denominators,
+                              row_value, stencil)
 from .viscosity import _rate_factor, _rate_factor_array
 
 __all__ = ["A_ROW_MAX", "BarusTime", "MIN_GROUP_ROWS", "barus_time", "served_groups"]
@@ -103,12 +105,12 @@ def barus_time(model, pr, bt, c, x_fast, aE, v_max):
     nz = pr.nz
     if z_need > pr.z0 + (nz - 1) * pr.dz:
         nz = int(math.ceil((z_need - pr.z0) / pr.dz)) + 2
-    xg = np.ascontiguousarray(xn[:rows])
-    C = np.empty((rows, nz, 3))
-    _build_kernel(pr, bt, c, float(aE), nz, C)
+    prr = refined_rows(pr, rows, aE)
+    xg = prr.xn
+    C = np.empty((xg.size, nz, 3))
+    _build_kernel(prr, bt, c, float(aE), nz, C)
     rec = readonly_fields(Primitive(xg, *_index_map(xg), lagrange_denominators(xg), pr.z0, pr.dz,
-                                    nz, C, *(np.ascontiguousarray(a[:rows]) for a in
-                                             (pr.lnv, pr.lnS, pr.zs, pr.lk)),
+                                    nz, C, prr.lnv, prr.lnS, prr.zs, prr.lk,
                                     math.inf, pr.c, pr.d))
     out = BarusTime(rec, float(min(x_fast, x_lim, xg[-1])), pr.z0 + (nz - 1) * pr.dz, aE)
     with _LOCK:
@@ -117,6 +119,75 @@ def barus_time(model, pr, bt, c, x_fast, aE, v_max):
         while len(_MEMO) > _MEMO_SIZE:
             _MEMO.popitem(last=False)
     return out
+
+
+#: spacing in x0 = ln(p0/E*) of the G primitive's rows where A = α p0 = API_FAST: G = T + A S
+#: varies with x0 through A ∝ e^x0 as well, so that its 4-point Lagrange interpolation across
+#: rows errs by ~ (A S/G) Δx⁴/40 — 1e-6 of the times at A = 0.6 on the base rows' widest
+#: spacing (0.08-0.09 where σ̄ barely changes, low p0/E*), against 1e-9 for T itself. Rows are
+#: inserted (by the base primitive's own interpolant) until Δx <= DX_G (API_FAST/A)^(1/4)
+#: (error ∝ A Δx⁴ held below its value at DX_G, A = API_FAST: ~1e-8 of the times)
+DX_G = 0.025
+
+
+def refined_rows(pr, rows, aE):
+    """The base primitive's first ``rows`` rows, with rows inserted where their spacing in x0
+    exceeds DX_G (API_FAST/A)^(1/4) (A = α E* e^x0 at the interval's upper end): each inserted
+    row is the base interpolant at its x0 (C, ln v∞, ln S, z of the default start and ln κ
+    combined with the base stencil's weights), so that T on the refined rows is the base
+    engine's T; only the correction A S is evaluated anew on them. A record with the fields
+    ``xn, lnv, lnS, zs, lk, C`` and the base's z grid and tail (as :func:`_build_kernel`
+    reads it); the base rows themselves (as before) where none is inserted."""
+    xn = pr.xn[:rows]
+    A_hi = np.minimum(aE * np.exp(xn[1:]), A_ROW_MAX)
+    dx_max = DX_G * (API_FAST / np.maximum(A_hi, 1e-300)) ** 0.25
+    m = np.maximum(np.ceil(np.diff(xn) / dx_max).astype(np.int64), 1)
+    fields = [np.ascontiguousarray(a[:rows]) for a in (pr.lnv, pr.lnS, pr.zs, pr.lk)]
+    if np.all(m == 1):
+        return Primitive(np.ascontiguousarray(xn), 0.0, 0.0, np.zeros(0), np.zeros((0, 4)),
+                         pr.z0, pr.dz, pr.nz, np.ascontiguousarray(pr.C[:rows]), *fields,
+                         pr.v_ext, pr.c, pr.d)
+    base = np.cumsum(np.concatenate(([0], m)))          # positions of the base rows
+    nr = int(base[-1]) + 1
+    xr = np.empty(nr)
+    new = np.ones(nr, dtype=bool)
+    new[base] = False
+    j = np.repeat(np.arange(m.size), m - 1)             # the base interval of each new row
+    k = np.arange(nr)[new] - base[j]                    # its place in the interval (1..m-1)
+    xr[new] = xn[j] + (xn[j + 1] - xn[j]) * k / m[j]
+    xr[base] = xn
+    C = np.empty((nr, pr.nz, 3))
+    C[base] = pr.C[:rows]
+    lnv, lnS, zs, lk = (np.empty(nr) for _ in range(4))
+    for out, a in zip((lnv, lnS, zs, lk), fields):
+        out[base] = a
+    _refined_kernel(pr, xr, np.flatnonzero(new), C, lnv, lnS, zs, lk)
+    return Primitive(xr, 0.0, 0.0, np.zeros(0), np.zeros((0, 4)), pr.z0, pr.dz, pr.nz, C,
+                     lnv, lnS, zs, lk, pr.v_ext, pr.c, pr.d)
+
+
+@njit(parallel=True, cache=True)
+def _refined_kernel(pr, xr, idx, C, lnv, lnS, zs, lk):
+    """The inserted rows ``idx`` of :func:`refined_rows` (at x0 = xr[idx]): the base rows'
+    stencil combination."""
+    for ii in prange(idx.size):
+        i = idx[ii]
+        _refined_row(pr, xr[i], i, C, lnv, lnS, zs, lk)
+
+
+@njit(cache=True)
+def _refined_row(pr, x0, i, C, lnv, lnS, zs, lk):
+    st = stencil(pr, x0)
+    j0, w0, w1, w2, w3 = st
+    lnv[i] = row_value(pr.lnv, st)
+    lnS[i] = row_value(pr.lnS, st)
+    zs[i] = row_value(pr.zs, st)
+    lk[i] = row_value(pr.lk, st)
+    B = pr.C
+    for k in range(pr.nz):
+        for q in range(3):
+            C[i, k, q] = (w0 * B[j0, k, q] + w1 * B[j0 + 1, k, q] + w2 * B[j0 + 2, k, q]
+                          + w3 * B[j0 + 3, k, q])
 
 
 @njit(cache=True)

@@ -60,10 +60,6 @@ def node_points(theory):
     return THEORY_NODE_POINTS.get(theory, NODE_POINTS)
 
 
-#: relative step of the central difference for dh/dz at the nodes
-HZ = 1e-4
-
-
 #: x0-independent state along s = ln v (cubic Hermite on a fine uniform grid, below the table
 #: top): ell = ln π_c, lam = ln σ̄ and their s-derivatives; above v_top the analytic tail
 Profile = namedtuple("Profile", "s0 ds A")  # A[i] = (ell, dell, lam, dlam) at s0 + i ds
