@@ -2,7 +2,8 @@
 baselines measured in the same run on this machine.
 
 Writes ``bench/seal_results.md`` (a Markdown fragment for bench/collect.py).
-Run: ``python bench/bench_seal.py [--quick]``.
+Run: ``python bench/bench_seal.py [--quick] [--only-pb]`` (``--only-pb``: only the O-rings with
+p_b > 0, their block of the results file replaced).
 
 * error: max relative error of Q against ``tests/reference/seal_reference.py`` (direct contact
   core, no tables): flat rings by composite Gauss–Legendre of direct σ_eff over the interval
@@ -16,6 +17,8 @@ Run: ``python bench/bench_seal.py [--quick]``.
   uniform call (the rate 2 uncontended cores would give).
 * baselines (same run): the reference's own cost per case; for O-rings also the direct panel
   solver (``solver=dict(table=False)``: today's per-case Newton, now on a ``prange`` driver).
+* O-rings with p_b > 0: the p_b > 0 table (steady state, the call that builds it) against
+  the per-row solver on the same rows, and the max rel. error of Q against it.
 """
 from __future__ import annotations
 
@@ -162,12 +165,91 @@ def hertz_section(tables, psd, quick, repeats):
                 fallback=fallback)
 
 
+#: O-rings with p_b > 0: p_H/E* log-uniform in PB_PH (a band narrow enough for 200,000 rows
+#: to pay for the table they need: a call builds it only where that takes no more solves than
+#: its rows), p_a/p_H uniform in [1e-3, 0.999], p_b/p_a uniform in [0, 0.9]
+PB_N = 200_000
+PB_PH = (0.01, 0.03)
+PB_HEAD = "### Hertz O-rings with an outlet pressure p_b > 0 (`--only-pb`)"
+
+
+def hertz_pb_section(repeats):
+    """Rows/s of O-rings with p_b > 0 from the p_b > 0 table (steady state and the call that
+    builds it) against the per-row solver, and the max rel. error of Q against it."""
+    rng = np.random.default_rng(3)
+    pH = np.exp(rng.uniform(math.log(PB_PH[0]), math.log(PB_PH[1]), PB_N)) * E
+    pa = rng.uniform(1e-3, 0.999, PB_N) * pH
+    pb = rng.uniform(0.0, 0.9, PB_N) * pa
+    kw = dict(profile="hertz", R=R, f_N=math.pi * R * pH ** 2 / E, dp=pa - pb, p_b=pb,
+              L_y=L_Y, E_star=E, eta=ETA, alpha_cj=ALPHA)
+    fresh = fc.Tables.from_parquet(TABLE_FILE)
+    fc.seal_leak(fresh, p0=5e4, dp=1e3, L=L, L_y=L_Y, E_star=E, eta=ETA)   # the context
+    t0 = time.perf_counter()
+    first = fc.seal_leak(fresh, **kw)
+    t_first = time.perf_counter() - t0
+    t_table = median_time(lambda: fc.seal_leak(fresh, **kw), repeats)
+    t0 = time.perf_counter()
+    ref = fc.seal_leak(fresh, **kw, solver=dict(table=False))
+    t_solver = time.perf_counter() - t0
+    ht = fastcontact.seal.hertz.hertz_pb_table(fc.seal.context.seal_context(
+        fresh, "critical_junction")).rec
+    ok = (ref.status == "ok").to_numpy()
+    tab = ok & (first.error_estimate.to_numpy() == fc.seal.hertz.VERIFY_TOL)
+    err = float(np.max(np.abs(first.Q[ok] / ref.Q[ok] - 1))) if ok.any() else math.nan
+    lines, cells = int(ht.built.sum()), int((ht.cell > 0).sum())
+    return dict(t_first=t_first, t_table=t_table, t_solver=t_solver, err=err,
+                served=float(tab.sum() / max(ok.sum(), 1)), ok=int(ok.sum()), lines=lines,
+                cells=cells, failed=int((ht.cell == 2).sum()),
+                solves=lines * (fastcontact.seal.hertz.NY + 1) + cells)
+
+
+def hertz_pb_lines(p):
+    """The Markdown block of :func:`hertz_pb_section`."""
+    n = PB_N
+    return [
+        PB_HEAD,
+        "",
+        f"{n:,} O-rings, p_H/E* log-uniform in {list(PB_PH)}, p_a/p_H uniform in [1e-3, 0.999], "
+        f"p_b/p_a uniform in [0, 0.9] (critical junction, α_cj = {ALPHA}); {p['ok']:,} rows "
+        f"status \"ok\", {p['served'] * 100:.2f} % of them served by the table. Table built by "
+        f"the first call: {p['lines']:,} grid lines (ln π_H, z) of {fastcontact.seal.hertz.NY + 1} "
+        f"nodes and {p['cells']:,} cells verified ({p['failed']:,} failed: solver), "
+        f"{p['solves']:,} solves at the table tolerance.",
+        "",
+        "| path | end-to-end rows/s | × solver | max rel. error of Q vs solver |",
+        "|---|---|---|---|",
+        f"| table (steady state, table kept) | {n / p['t_table']:.3g} | "
+        f"{p['t_solver'] / p['t_table']:.3g} | {p['err']:.1e} |",
+        f"| table, first call (builds it: lines + verification) | {n / p['t_first']:.3g} | "
+        f"{p['t_solver'] / p['t_first']:.3g} | same rows |",
+        f"| per-row solver (`solver=dict(table=False)`, prange) | {n / p['t_solver']:.3g} | 1 | "
+        f"– |",
+        "",
+    ]
+
+
+def splice_pb(path, block):
+    """Replace the p_b > 0 block (from PB_HEAD to the end of the generated part) of the results
+    file at ``path`` by ``block`` (appended when absent), keeping the rest and its notes."""
+    from results_notes import NOTES_MARK
+    text = Path(path).read_text() if Path(path).is_file() else ""
+    lines = text.splitlines()
+    end = next((i for i, ln in enumerate(lines) if ln.startswith(NOTES_MARK)), len(lines))
+    gen = lines[:end]
+    if PB_HEAD in gen:
+        gen = gen[:gen.index(PB_HEAD)]
+    return "\n".join(gen).rstrip() + "\n\n" + "\n".join(block)
+
+
 TABLE_FILE = str(Path(os.environ.get("TMPDIR", "/tmp")) / "fastcontact_bench_seal_tables.parquet")
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--only-pb", action="store_true",
+                    help="run only the O-rings with p_b > 0 and replace their block in "
+                         "seal_results.md (the other sections are kept as they are)")
     args = ap.parse_args()
     repeats = 3 if args.quick else 5
     load0 = os.getloadavg()
@@ -176,8 +258,16 @@ def main():
     tables = fc.precompute(psd)
     t_pre = time.perf_counter() - t0
     tables.to_parquet(TABLE_FILE)
+    if args.only_pb:
+        block = hertz_pb_lines(hertz_pb_section(repeats))
+        block[2] += (f" {machine()}; load average {tuple(round(x, 2) for x in load0)} at the "
+                     f"start, {tuple(round(x, 2) for x in os.getloadavg())} at the end.")
+        write_keeping_notes(HERE / "seal_results.md", splice_pb(HERE / "seal_results.md", block))
+        print("\n".join(block))
+        return
     u = uniform_section(tables, psd, args.quick, repeats)
     h = hertz_section(tables, psd, args.quick, repeats)
+    pb = hertz_pb_lines(hertz_pb_section(repeats))
     load1 = os.getloadavg()
     md = [
         "## Seal leak rate — `bench/bench_seal.py`",
@@ -223,7 +313,7 @@ def main():
         f"(not counted; their direct reference Q in m³/s): {u['flagged']}. Uniform cases "
         f"whose direct reference is already percolated (not counted): {u['zero']}.",
         "",
-    ]
+    ] + pb
     write_keeping_notes(HERE / "seal_results.md", "\n".join(md))
     print("\n".join(md))
 

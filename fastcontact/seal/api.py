@@ -32,7 +32,7 @@ from ._inputs import (alpha_scale, check_tables, check_theory_for, common_inputs
 from .context import (EQUALITY_TOL, NEAR_LIFT_OFF, peak_past_trust, seal_context,
                       solve_profile_rows, solver_options)
 from ._uniform import leak_uniform
-from .hertz import VERIFY_TOL, table_W
+from .hertz import VERIFY_TOL, tabled_W
 from .viscosity import seal_leak_piezo  # issue 14: Barus fluid (alpha_pv)
 
 __all__ = ["seal_leak", "columns", "STATUS", "UNITS", "REFERENCES", "EQUALITY_TOL"]
@@ -138,12 +138,12 @@ def _leak_hertz(sc, theory, R, f_N, com, alpha_cj, o):
     idx = np.flatnonzero(solve)
     piH = np.ascontiguousarray(pH / E)
     pia = np.ascontiguousarray(p_a / E)
-    Wt = None
-    if o["table"]:
-        Wt = table_W(sc, piH, pia, idx[(p_b[idx] == 0.0) & (p_a[idx] != pH[idx])])
+    pib = np.ascontiguousarray(p_b / E)
+    Wt = tabled_W(sc, piH, pia, pib, idx[p_a[idx] != pH[idx]], p_b == 0.0) if o["table"] \
+        else None
+    if Wt is not None:
         idx = idx[~np.isfinite(Wt[idx])]
-    out = solve_profile_rows(sc, o, 0, np.zeros(2), np.zeros(2), piH, pia,
-                              np.ascontiguousarray(p_b / E), idx,
+    out = solve_profile_rows(sc, o, 0, np.zeros(2), np.zeros(2), piH, pia, pib, idx,
                               p_a[idx] >= (1.0 - NEAR_LIFT_OFF) * pH[idx])
     if Wt is not None:
         fast = np.isfinite(Wt)
@@ -247,6 +247,13 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
         Knobs of the non-uniform solver (``fastcontact.seal.SOLVER_DEFAULTS``). Rows at or
         within ``NEAR_LIFT_OFF`` (1e-4 relative) below lift-off are solved at the panel
         tolerance EQUALITY_TOL (1e-9) whatever ``tol`` is (Q has a square-root limit there).
+        ``table`` (default True): Hertz O-rings read W from the verified tables of
+        :mod:`fastcontact.seal.hertz` (``error_estimate`` = VERIFY_TOL, 2e-7 in ln W, on those
+        rows), built as far as the rows need and kept: p_b = 0 always, p_b > 0 where
+        completing that table costs no more solves than those rows (e.g. 200,000 O-rings of
+        p_H/E* within a factor 3; not a few thousand of scattered p_H, until a kept table
+        covers them); rows whose cells are not verified (next to lift-off or percolation, and
+        p_a, p_b both within ~1 % of p_H) are solved. False: every row by the solver.
     alpha_pv : float or array_like, default 0.0
         Barus coefficient α [1/Pa], η = η0 exp(α(p_f − p_b)); 0 leaves the result unchanged.
     viscosity : {"barus", "roelands"}, default "barus"

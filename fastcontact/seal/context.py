@@ -233,6 +233,8 @@ class SealContext:
         self.a_perc = float(tables.options.get("a_perc", 0.5))
         self.hertz = None            # the O-ring table (fastcontact.seal.hertz), built lazily
         self.hertz_piezo = {}        # O-ring tables of Barus fluids by α̃ = α E* (the same)
+        self.hertz_pb = None         # the O-ring table for p_b > 0 (hertz.HertzPbTable holder)
+        self.hertz_pb_piezo = {}     # its tables of Barus/Roelands fluids (the same keys)
         self.build_seconds = time.perf_counter() - t_start
 
 
@@ -283,7 +285,8 @@ EQUALITY_TOL = 1e-9
 #: soft-seal solver knobs (non-uniform profiles): Gauss–Legendre nodes per panel, initial
 #: panels, grading order of the end map, panel error tolerance (Legendre tail of the
 #: resistance density relative to the total), maximum panels, Newton iterations per mesh;
-#: ``table``: O-rings with p_b = 0 from the verified table of W (:mod:`.hertz`).
+#: ``table``: O-rings from the verified tables of W (:mod:`.hertz`; p_b = 0 and, where
+#: completing the table for them costs no more solves than those rows, p_b > 0).
 SOLVER_DEFAULTS = dict(nodes=10, panels=4, grading=2, tol=1e-3, max_panels=128, max_newton=60,
                        table=True)
 

@@ -1,10 +1,26 @@
-"""The O-ring fast path: a lazily built, verified table of the reduced resistance W.
+"""The O-ring fast path: lazily built, verified tables of the reduced resistance W.
 
-:class:`HertzTable` (a flat record) holds ln W on a grid in (ln π_H, y) for p_b = 0 (see
-:mod:`._hertz`); columns are solved on demand, cells verified at their centre against the
-solver before use. Built per (tables, theory), cached on its :class:`SealContext`; a Barus
-fluid's table (α̃ = α E*, p_b = 0: one α and one E* make W a function of (π_H, π_a) again)
-the same way, per α̃, the solver run with that α̃; a Roelands fluid's per law (A, Z, p_r/E*).
+W = ∫ dξ/σ̄ over the sealing zone (ξ = x/a; Lorenz & Persson 2010, eq. 33 with the Hertz
+profile p0 = p_H √(1 − ((x − a)/a)²)) depends on π_H = p_H/E*, π_a = p_a/E* and π_b = p_b/E*
+alone (q = Δp h_rms³/(12 η a W) [m²/s], h_rms [m], a [m]). Two tables (kernels in
+:mod:`._hertz`):
+
+* :class:`HertzTable`: ln W on a grid in (ln π_H, y) for p_b = 0 (:func:`table_W`);
+* :class:`HertzPbTable`: ln W on a grid in (ln π_H, y, z) for p_b > 0 (:func:`table_W_pb`),
+  z = y(π_b)/y(π_a) ∈ [0, 1] on NZ = 24 uniform intervals (z ≈ p_b/p_a where p_a << p_H;
+  z = 1 is dp → 0, the linear-response limit, solved at p_b = p_a (1 − 1e-12) as the p_b = 0
+  table's y = 0 at p_a = 1e-12 p_H). Its grid lines (ln π_H, z) are solved on demand, all
+  NY + 1 y nodes at once, and its planes allocated as first needed.
+
+Both are filled only as far as the rows of a call need (grid rows, resp. lines, of the 6-point
+stencils of their cells), every cell verified at its centre against the solver (VERIFY_TOL =
+2e-7 in ln W) before use; cells that fail — next to lift-off and percolation, and for p_b > 0
+where p_a and p_b both approach p_H (the zone shrinks to the peak; with NZ = 24 about 10 % of
+the (y, z) cells, at p_a/p_H > 0.99) — go to the solver. Built per (tables, theory), kept on
+the :class:`SealContext`; a Barus fluid's tables (α̃ = α E*, η = η0 e^{α(p_f − p_b)}: one α
+and one E* make W a function of (π_H, π_a, π_b) again) the same way, per α̃, the solver run
+with that α̃; a Roelands fluid's per law (A, Z, p_r/E*); the last PIEZO_TABLES fluids of each
+kind of table are kept.
 """
 from __future__ import annotations
 
@@ -17,7 +33,8 @@ import numpy as np
 from . import _hertz, _panels
 from .context import RowsOut, panel_rule, solver_options
 
-__all__ = ["HertzTable", "hertz_table", "table_W", "H1", "NY", "TABLE_TOL", "VERIFY_TOL"]
+__all__ = ["HertzTable", "hertz_table", "table_W", "HertzPbTable", "hertz_pb_table", "table_W_pb",
+           "tabled_W", "H1", "NY", "NZ", "TABLE_TOL", "VERIFY_TOL"]
 
 #: grid spacing in ln π_H, number of y intervals
 H1 = 0.05
@@ -28,7 +45,7 @@ VERIFY_TOL = 2e-7
 
 
 class HertzTable(NamedTuple):
-    """Flat record: ln W at ln π_H = t0 + k h1 (rows) and y = j/NY (columns).
+    """Flat record: ln W for p_b = 0 at ln π_H = t0 + k h1 (rows) and y = j/NY (columns).
 
     Attributes
     ----------
@@ -63,17 +80,24 @@ def hertz_table(sc, al=0.0, vis=None):
     one E*, W is again a function of (π_H, π_a) alone); ``vis`` = (A, Z, π_r): a Roelands
     fluid's (the law of :mod:`fastcontact.flow.piezoviscosity`, π_r = p_r/E*); kept for the
     last PIEZO_TABLES fluids."""
+    return _kept(sc, "hertz", "hertz_piezo", al, vis, _empty_table)
+
+
+def _kept(sc, base, piezo, al, vis, make):
+    """The table ``make(sc)`` of a fluid kept on the SealContext: the base fluid's in the
+    attribute ``base``, a Barus (α̃ = ``al`` > 0) or Roelands (``vis``) fluid's in the dict
+    ``piezo`` (the last PIEZO_TABLES fluids asked, most recent last)."""
     key = float(al) if vis is None else tuple(float(x) for x in vis)
     with _LOCK:
         if key == 0.0:
-            if sc.hertz is None:
-                sc.hertz = _empty_table(sc)
-            return sc.hertz
-        memo = sc.hertz_piezo
+            if getattr(sc, base) is None:
+                setattr(sc, base, make(sc))
+            return getattr(sc, base)
+        memo = getattr(sc, piezo)
         if key in memo:
             memo[key] = memo.pop(key)  # most recent last
         else:
-            memo[key] = _empty_table(sc)
+            memo[key] = make(sc)
             while len(memo) > PIEZO_TABLES:
                 memo.pop(next(iter(memo)))
         return memo[key]
@@ -86,9 +110,11 @@ def _empty_table(sc):
                       np.zeros(K, dtype=np.bool_))
 
 
-def _solve_W(sc, piH, pia, equal, al=0.0, vis=None):
-    """W of (π_H, π_a) points (p_b = 0; Barus α̃ = ``al``, or the Roelands law ``vis``) with
-    the table's tight solver settings."""
+def _solve_W(sc, piH, pia, equal, al=0.0, vis=None, pib=None):
+    """W of (π_H, π_a, π_b) points (``pib`` None: p_b = 0; Barus α̃ = ``al``, or the Roelands
+    law ``vis``) with the table's tight solver settings; ``equal``: the points at the lift-off
+    equality p_a = p_H (panel tolerance 1e-9)."""
+    pib = np.zeros(piH.size) if pib is None else np.ascontiguousarray(pib, dtype=np.float64)
     o = solver_options(None)
     out = RowsOut.empty(piH.size)
     law = (np.zeros((piH.size, 0)) if vis is None
@@ -100,7 +126,7 @@ def _solve_W(sc, piH, pia, equal, al=0.0, vis=None):
         rule = panel_rule(o, tol=1e-9 if eq else TABLE_TOL, max_panels=256)
         _panels.solve_rows(sc.tab, sc.rec, rule, 0, np.zeros(2), np.zeros(2),
                            np.ascontiguousarray(piH), np.ascontiguousarray(pia),
-                           np.zeros(piH.size), np.full(piH.size, float(al)), law,
+                           pib, np.full(piH.size, float(al)), law,
                            idx.astype(np.int64), out)
     return np.where(out.status == _panels.ST_NEWTON_FAILED, np.nan, out.W)
 
@@ -110,10 +136,7 @@ def _build_rows(sc, ht, ks, al=0.0, vis=None):
     ks = np.asarray([k for k in ks if not ht.built[k]], dtype=np.int64)
     if not ks.size:
         return
-    y = np.arange(NY + 1) / NY
-    r = np.array([_hertz.ra_of_y(v) for v in y])
-    r[0] = 1e-12                                   # dp → 0: the linear-response limit
-    r[-1] = 1.0
+    r = _r_nodes()
     piH = np.repeat(np.exp(ht.t0 + ht.h1 * ks), NY + 1)
     rr = np.tile(r, ks.size)
     W = _solve_W(sc, piH, rr * piH, np.tile(np.arange(NY + 1) == NY, ks.size), al, vis)
@@ -122,16 +145,30 @@ def _build_rows(sc, ht, ks, al=0.0, vis=None):
     ht.built[ks] = True
 
 
+def _r_nodes():
+    """r = p_a/p_H at the y nodes j/NY (r = 1e-12 at y = 0: dp → 0, the linear-response
+    limit; 1 at y = 1, the lift-off equality)."""
+    r = np.array([_hertz.ra_of_y(v) for v in np.arange(NY + 1) / NY])
+    r[0] = 1e-12
+    r[-1] = 1.0
+    return r
+
+
 def _verify_cells(sc, ht, kc, jc, al=0.0, vis=None):
     """Solve at the centres of cells (kc, jc) and compare with the interpolation."""
     piH = np.exp(ht.t0 + ht.h1 * (kc + 0.5))
     pia = piH * np.array([_hertz.ra_of_y((j + 0.5) / NY) for j in jc])
-    W = _solve_W(sc, piH, pia, np.zeros(kc.size, dtype=bool), al, vis)
     est = np.empty(kc.size)
     _hertz.hertz_interp(ht, piH, pia, np.arange(kc.size, dtype=np.int64), True, est)
+    ht.cell[kc, jc] = np.where(_verified(sc, piH, pia, None, est, al, vis), 1, 2)
+
+
+def _verified(sc, piH, pia, pib, est, al, vis):
+    """True where the interpolated ln W ``est`` at the points (π_H, π_a, π_b) is within
+    VERIFY_TOL of the solver's."""
+    W = _solve_W(sc, piH, pia, np.zeros(piH.size, dtype=bool), al, vis, pib)
     with np.errstate(invalid="ignore", divide="ignore"):
-        good = np.abs(est - np.log(W)) <= VERIFY_TOL
-    ht.cell[kc, jc] = np.where(good, 1, 2)
+        return np.abs(est - np.log(W)) <= VERIFY_TOL
 
 
 def table_W(sc, piH, pia, rows, al=0.0, vis=None, max_solves=None):
@@ -170,3 +207,193 @@ def _y_vec(piH, pia):
     q = np.maximum((piH - pia) / (2.0 * piH), 0.0)
     thp = 2.0 * np.arcsin(np.sqrt(q))
     return 1.0 - np.sqrt(np.maximum(2.0 * thp / np.pi, 0.0))
+
+
+# =========================================================================== p_b > 0
+#: intervals of the outlet coordinate z = y(π_b)/y(π_a) of the p_b > 0 table: measured on
+#: the (y, z) cells at π_H = 1.1e-3, 0.01, 0.045 (critical junction and EMT), cells verified
+#: 77–80 % (49 % at 0.045) with 16, 86 % with 20, 87–90 % with 24, 94 % with 32 intervals,
+#: every cell below y = 0.6 (p_a/p_H < 0.97) with 24; a line costs NY + 1 = 129 solves
+NZ = 24
+#: z = 1 (dp → 0, the linear-response limit) is solved at p_b = p_a (1 − Z_TOP_GAP)
+Z_TOP_GAP = 1e-12
+
+
+class HertzPbTable(NamedTuple):
+    """Flat record: ln W for p_b > 0 at ln π_H = t0 + k h1, z = m/NZ and y = j/NY.
+
+    Grid rows k are stored as planes, allocated as they are first needed.
+
+    Attributes
+    ----------
+    t0, h1 : float
+        Grid in ln π_H.
+    slot : ndarray of int64
+        Plane of grid row k in ``lw``, ``cell`` and ``built`` (-1: none yet), shape (K,).
+    lw : ndarray
+        ln W (NaN where not built or the solver failed), shape (planes, NZ + 1, NY + 1).
+    cell : ndarray of int8
+        Cell state (planes, NZ, NY): 0 not checked, 1 verified, 2 failed (solver fallback).
+    built : ndarray of bool
+        Grid lines (k, z_m) solved (all NY + 1 y nodes), shape (planes, NZ + 1).
+    """
+
+    t0: float
+    h1: float
+    slot: np.ndarray
+    lw: np.ndarray
+    cell: np.ndarray
+    built: np.ndarray
+
+
+class _PbBox:
+    """The :class:`HertzPbTable` of one fluid kept on a SealContext (``rec`` is replaced as
+    planes are added)."""
+
+    __slots__ = ("rec",)
+
+    def __init__(self, sc):
+        t0 = sc.rec.t_lo - 3.0
+        K = int(math.ceil((math.log(sc.p_top) - t0) / H1)) + 1
+        self.rec = HertzPbTable(t0, H1, np.full(K, -1, dtype=np.int64),
+                                np.zeros((0, NZ + 1, NY + 1)),
+                                np.zeros((0, NZ, NY), dtype=np.int8),
+                                np.zeros((0, NZ + 1), dtype=np.bool_))
+
+
+def hertz_pb_table(sc, al=0.0, vis=None):
+    """The (lazily filled) :class:`HertzPbTable` holder of a SealContext for p_b > 0, keyed
+    as :func:`hertz_table` (base; Barus α̃ = α E*, η = η0 e^{α(p_f − p_b)}; Roelands law
+    (A, Z, π_r) about p_b): W depends on (π_H, π_a, π_b) alone for each."""
+    return _kept(sc, "hertz_pb", "hertz_pb_piezo", al, vis, _PbBox)
+
+
+def _ra(y):
+    """:func:`._hertz.ra_of_y` of an array."""
+    return np.sin(0.5 * np.pi * (1.0 - (1.0 - y) ** 2))
+
+
+def _with_planes(ht, ks):
+    """``ht`` with planes for the grid rows ks that have none."""
+    new = np.unique(ks[ht.slot[ks] < 0])
+    if not new.size:
+        return ht
+    slot = ht.slot.copy()
+    slot[new] = ht.lw.shape[0] + np.arange(new.size)
+    n = new.size
+    return ht._replace(
+        slot=slot, lw=np.concatenate((ht.lw, np.full((n, NZ + 1, NY + 1), np.nan))),
+        cell=np.concatenate((ht.cell, np.zeros((n, NZ, NY), dtype=np.int8))),
+        built=np.concatenate((ht.built, np.zeros((n, NZ + 1), dtype=np.bool_))))
+
+
+def _stencil_lines(kc, mc):
+    """Grid lines (k(NZ + 1) + m) of the 6×6 (ln π_H, z) stencils of cells (kc, mc)."""
+    ms = np.clip(mc - 2, 0, NZ - 5)
+    k = kc[:, None, None] + np.arange(-2, 4)[None, :, None]
+    m = ms[:, None, None] + np.arange(6)[None, None, :]
+    return np.unique((k * (NZ + 1) + m).ravel())
+
+
+def _unbuilt(ht, lines):
+    """Number of the grid lines not solved yet."""
+    return int((~_on_planes(ht.built, ht.slot[lines // (NZ + 1)], lines % (NZ + 1))).sum())
+
+
+def _on_planes(a, s, *idx):
+    """a[s, *idx] where the plane s exists (s >= 0), else 0 (False)."""
+    out = np.zeros(s.size, dtype=a.dtype)
+    has = s >= 0
+    out[has] = a[(s[has],) + tuple(i[has] for i in idx)]
+    return out
+
+
+def _build_lines(sc, ht, lines, al=0.0, vis=None):
+    """``ht`` with the grid lines solved (all y nodes; planes added as needed)."""
+    kl, ml = lines // (NZ + 1), lines % (NZ + 1)
+    ht = _with_planes(ht, kl)
+    s = ht.slot[kl]
+    todo = ~ht.built[s, ml]
+    kl, ml, s = kl[todo], ml[todo], s[todo]
+    if not kl.size:
+        return ht
+    r = _r_nodes()
+    ya = np.array([_hertz.y_of(1.0, v) for v in r])     # the nodes' own y (r[0] = 1e-12)
+    z = (ml / NZ)[:, None]
+    rb = np.where(ml[:, None] == NZ, r * (1.0 - Z_TOP_GAP), _ra(z * ya[None, :]))
+    piH = np.repeat(np.exp(ht.t0 + ht.h1 * kl), NY + 1)
+    W = _solve_W(sc, piH, np.tile(r, kl.size) * piH,
+                 np.tile(np.arange(NY + 1) == NY, kl.size), al, vis, rb.ravel() * piH)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ht.lw[s, ml] = np.log(W).reshape(kl.size, NY + 1)
+    ht.built[s, ml] = True
+    return ht
+
+
+def _verify_pb_cells(sc, ht, kc, mc, jc, al=0.0, vis=None):
+    """Solve at the centres of cells (kc, mc, jc) and compare with the interpolation."""
+    piH = np.exp(ht.t0 + ht.h1 * (kc + 0.5))
+    y = (jc + 0.5) / NY
+    pia = piH * _ra(y)
+    pib = piH * _ra((mc + 0.5) / NZ * y)
+    est = np.empty(kc.size)
+    _hertz.hertz_pb_interp(ht, piH, pia, pib, np.arange(kc.size, dtype=np.int64), True, est)
+    ht.cell[ht.slot[kc], mc, jc] = np.where(_verified(sc, piH, pia, pib, est, al, vis), 1, 2)
+
+
+def _pb_cells(ht, piH, pia, pib, rows):
+    """(k, m, j): grid row, z cell and y cell of the rows (:func:`._hertz.pb_cells`)."""
+    k, j, m = (np.empty(rows.size, dtype=np.int64) for _ in range(3))
+    _hertz.pb_cells(ht, piH, pia, pib, np.ascontiguousarray(rows, dtype=np.int64), k, j, m)
+    return k, m, j
+
+
+def table_W_pb(sc, piH, pia, pib, rows, al=0.0, vis=None, max_solves=None):
+    """W [-] of the rows with p_b > 0 (π_b = ``pib`` < π_a <= π_H) from the p_b > 0 table (of
+    the base fluid, the Barus fluid α̃ = ``al`` > 0 or the Roelands law ``vis``); NaN where
+    the solver must be used. As :func:`table_W`: the grid lines (k, z_m) the rows' cells need
+    are solved (NY + 1 solves each) and the cells verified at their centre (one solve each)
+    first; ``max_solves``: None (and no table read) where that would take more solves."""
+    pib = np.ascontiguousarray(pib, dtype=np.float64)
+    box = hertz_pb_table(sc, al, vis)
+    with _LOCK:
+        ht = box.rec
+        k, m, j = _pb_cells(ht, piH, pia, pib, rows)
+        inside = (k >= 2) & (k <= ht.slot.size - 4)
+        cells = np.unique((k[inside] * NZ + m[inside]) * NY + j[inside])
+        kc, mc, jc = cells // (NZ * NY), (cells // NY) % NZ, cells % NY
+        todo = _on_planes(ht.cell, ht.slot[kc], mc, jc) == 0
+        if todo.any():
+            lines = _stencil_lines(kc[todo], mc[todo])
+            if (max_solves is not None
+                    and _unbuilt(ht, lines) * (NY + 1) + int(todo.sum()) > max_solves):
+                return None
+            ht = box.rec = _build_lines(sc, ht, lines, al, vis)
+            _verify_pb_cells(sc, ht, kc[todo], mc[todo], jc[todo], al, vis)
+    lnW = np.full(piH.size, np.nan)
+    _hertz.hertz_pb_interp(ht, piH, pia, pib, np.ascontiguousarray(rows[inside], dtype=np.int64),
+                           False, lnW)
+    return np.exp(lnW)
+
+
+def tabled_W(sc, piH, pia, pib, rows, zero, al=0.0, vis=None, budget_zero=False):
+    """W [-] of O-ring rows below lift-off (π_a < π_H) from the verified tables of the fluid
+    (base; Barus α̃ = ``al``; Roelands law ``vis``), NaN for the rows to solve; None where
+    neither table is read. Rows with p_b = 0 (``zero``, per row of the call) from
+    :func:`table_W` (``budget_zero``: only where completing it costs no more solves than those
+    rows), rows with p_b > 0 from :func:`table_W_pb` where that holds."""
+    piH, pia, pib = (np.ascontiguousarray(x, dtype=np.float64) for x in (piH, pia, pib))
+    at0, back = rows[zero[rows]], rows[~zero[rows]]
+    read = []
+    if at0.size or not budget_zero:
+        read.append((at0, table_W(sc, piH, pia, at0, al, vis,
+                                  max_solves=at0.size if budget_zero else None)))
+    if back.size:
+        read.append((back, table_W_pb(sc, piH, pia, pib, back, al, vis, max_solves=back.size)))
+    read = [(r, W) for r, W in read if W is not None]
+    if not read:
+        return None
+    out = np.full(piH.size, np.nan)
+    for r, W in read:
+        out[r] = W[r]
+    return out

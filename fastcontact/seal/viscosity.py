@@ -174,11 +174,13 @@ def seal_leak_piezo(tables, *, dp, L_y, E_star, eta, alpha_pv, theory="critical_
         (Q = NaN) where they still differ. An integer: shooting with that many steps,
         unchecked (both laws). At least TABLE_MIN_ROWS (500) O-rings of one fluid (α E*, or
         the Roelands law with p_r/E*; in a call of several fluids, each of the four largest
-        such groups) with p_b = 0 read W from that fluid's verified O-ring table
-        (:mod:`fastcontact.seal.hertz`, built as far as needed and kept; ~1e-8 of the solver)
-        where building what it lacks costs fewer solves than the rows (Δp sweeps of a few
-        O-rings, a large study, a table kept from an earlier call), and solves only the rows
-        whose cells are not verified.
+        such groups) read W from that fluid's verified O-ring tables
+        (:mod:`fastcontact.seal.hertz`: p_b = 0 from the table of (π_H, π_a), p_b > 0 from the
+        one of (π_H, π_a, π_b); built as far as needed and kept; ~1e-8 of the solver) where
+        building what a table lacks costs fewer solves than its rows (Δp sweeps of a few
+        O-rings, a large study, a table kept from an earlier call; for p_b > 0 ~25× more
+        solves per O-ring p_H than for p_b = 0), and solves only the rows whose cells are not
+        verified.
     viscosity : {"barus", "roelands"}
         Viscosity law (module docstring; :mod:`fastcontact.flow.piezoviscosity`). Roelands:
         ln(η/η0) = ln(η0/η_∞)[(1 + (p_f - p_b)/p_r)^Z - 1], its reduced pressure
@@ -738,18 +740,17 @@ def _by_fluid(keys, eligible, one_fluid, solve):
 
 def _hertz_k_tabled(tables, theory, E, pH, a, pa, pb, al, vis, psia, solve):
     """(k [Pa/m], converged) of O-rings of one fluid (Barus α̃ = ``al``, or the Roelands law
-    ``vis``): the rows with p_b = 0 below lift-off from the fluid's verified O-ring table
-    (:func:`fastcontact.seal.hertz.table_W`; ~1e-8 in Q of the solver), k = ψ_a/(a W),
-    ``psia(i)`` the rows' ψ_a [Pa]; where completing the table for them would take more solves
-    than the rows themselves (a few hundred O-rings of scattered p_H; not a Δp sweep of a few
-    O-rings, a large study, or rows a kept table covers) every row, and the rows whose cells
-    are not verified, by ``solve(i)`` -> (k, converged)."""
-    from .hertz import table_W
+    ``vis``): the rows below lift-off from the fluid's verified O-ring tables
+    (:func:`fastcontact.seal.hertz.tabled_W`: p_b = 0 from the table of (π_H, π_a), p_b > 0
+    from the one of (π_H, π_a, π_b); ~1e-8 in Q of the solver), k = ψ_a/(a W), ``psia(i)``
+    the rows' ψ_a [Pa]; where completing a table for its rows would take more solves than the
+    rows themselves (a few hundred O-rings of scattered p_H; not a Δp sweep of a few O-rings, a
+    large study, or rows a kept table covers) those rows, and the rows whose cells are not
+    verified, by ``solve(i)`` -> (k, converged)."""
+    from .hertz import tabled_W
     n = E.size
-    rows = np.flatnonzero((pb == 0.0) & (pa < pH))
-    W = None if rows.size == 0 else table_W(
-        seal_context(tables, theory), np.ascontiguousarray(pH / E), np.ascontiguousarray(pa / E),
-        rows, al, vis, max_solves=rows.size)
+    W = tabled_W(seal_context(tables, theory), pH / E, pa / E, pb / E,
+                 np.flatnonzero(pa < pH), pb == 0.0, al, vis, budget_zero=True)
     if W is None:
         return solve(np.arange(n))
     fast = np.flatnonzero(np.isfinite(W))
