@@ -15,13 +15,20 @@ O-ring radii and loads, R, η, starts and times over many decades). Counted per 
 * anything raised: a ValueError whose text names a parameter and says "invalid" counts as a
   refused input, any other exception as a violation.
 
-    python bench/bench_fuzz_extensions.py [--n 4000] [--seed 20261202]
+* a reference subsample (``--n-ref`` draws within ``--ref-budget`` s): Q of Barus and
+  Roelands flat rings and O-rings (p_b = 0 and > 0; an O-ring alone and as row 0 of a call of
+  one fluid) against the independent solutions of ``tests/reference/ext_reynolds.py`` and
+  ``ext_roelands.py`` (η(p) integrated directly), off by more than the engines' stated
+  accuracy counting as a violation.
+
+    python bench/bench_fuzz_extensions.py [--n 4000] [--seed 20261202] [--n-ref 48]
 
 Writes bench/fuzz_extensions_results.md (bench/collect.py gathers it into RESULTS.md).
 """
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import platform
 import subprocess
@@ -62,6 +69,8 @@ class Tally:
         self.refused = Counter()
         self.first = {}
         self.info = Counter()
+        self.ref_worst = {}
+        self.ref_failed = Counter()
 
     def check(self, path, name, bad, detail=""):
         k = int(np.count_nonzero(bad))
@@ -215,11 +224,107 @@ def asperity(tally, tab, rng, n):
         tally.check(path, "t_star_base > t_sequential", fin & (tb > ts * (1 + 1e-12)))
 
 
+#: relative error of Q against the independent references counted as a violation: the
+#: engines' stated accuracy (O-ring panels PIEZO_PANEL_TOL = 1e-6; flat rings <= 1e-7)
+REF_TOL = {"uniform": 1e-7, "hertz": 1e-6}
+#: O-rings of one fluid per reference call: large enough that the fluid's verified O-ring table
+#: pays for itself (the call builds and reads it); row 0 is the reference row
+REF_BATCH = 2000
+
+
+def seal_references(tally, tab, rng, n_ref, budget):
+    """Q of random Barus and Roelands seals against the independent references of
+    ``tests/reference/ext_reynolds.py`` / ``ext_roelands.py`` (η(p) integrated directly:
+    solve_bvp for flat rings, adaptive DOP853 shooting for O-rings; no reduced pressure),
+    σ0 from the tables' public ``conductivity``. Draws: each theory in turn, flat ring or
+    O-ring, Barus or Roelands, p_b = 0 or up to 0.9 p_a; an O-ring draw is row 0 of a call of
+    REF_BATCH O-rings of one fluid on one rubber (the fluid's table path) and, alone, of a call
+    of its own (the per-row solver). Worst error per path into ``tally.info_ref``."""
+    sys.path.insert(0, str(HERE.parent / "tests"))
+    from reference import ext_reynolds as rb
+    from reference import ext_roelands as rr
+    from fastcontact.seal._inputs import hertz_contact
+    t_end = time.perf_counter() + budget
+    for k in range(n_ref):
+        if time.perf_counter() > t_end:
+            break
+        theory = THEORIES[k % 3]
+        profile = "hertz" if k % 2 == 0 else "uniform"
+        visc = "barus" if (k // 2) % 2 == 0 else "roelands"
+        E = float(_lu(rng, 1e6, 1e8, 1)[0])
+        eta, L_y = 1e-3, 0.1
+        pt = min(_pi_trust(tab, theory), 0.9 * tab.percolation_pressure(theory, 1.0),
+                 tab.p_range[1])
+        pH = E * float(_lu(rng, 1e-3, 0.9 * pt, 1)[0])
+        p_a = pH * rng.uniform(0.05, 0.95)
+        p_b = p_a * rng.uniform(0.0, 0.9) if rng.random() < 0.5 else 0.0
+        alpha = float(_lu(rng, 1e-3, 3.0, 1)[0]) / pH
+        # solve_bvp's iterates may leave the zone's contact pressures: σ0 clipped to the tables
+        plo, phi = tab.p_range[0] * E * (1 + 1e-7), tab.p_range[1] * E * (1 - 1e-7)
+        sigma0 = lambda pc: tab.conductivity(np.clip(pc, plo, phi), E, eta, theory)
+        kw = dict(L_y=L_y, E_star=E, eta=eta, theory=theory, p_b=p_b, dp=p_a - p_b)
+        if visc == "barus":
+            kw["alpha_pv"] = alpha
+            law = rb.barus(alpha)
+        else:
+            z = rng.uniform(0.4, 0.8)
+            pr_ = 1.96e8
+            kw.update(viscosity="roelands", roelands_z=z, roelands_p_r=pr_)
+            A = math.log(eta) + 9.67
+            law = lambda p, A=A, z=z, pr_=pr_: np.exp(A * ((1.0 + np.maximum(np.asarray(p) - p_b, 0.0) / pr_) ** z - 1.0))
+        path = f"reference {profile} {visc} {theory}" + (" p_b > 0" if p_b > 0 else "")
+        L = 1e-3
+        R = float(_lu(rng, 1e-3, 1e-2, 1)[0])
+        f_N = math.pi * R * pH ** 2 / E                   # p_H of the Hertz line contact
+        try:  # the reference first: where it does not converge the draw is not counted
+            if profile == "uniform":
+                want = _flat_reference(rb, rr, visc, sigma0, pH, L, p_a, p_b, alpha, law)[0] * L_y
+            else:
+                a = float(hertz_contact(R, f_N, E)[0])
+                shoot = rb.hertz_shoot if visc == "barus" else rr.hertz_shoot
+                want = shoot(sigma0, pH, a, p_a, p_b, alpha if visc == "barus" else law) * L_y
+        except Exception:  # noqa: BLE001 - scipy's solve_bvp / brentq gave up
+            tally.ref_failed[path] += 1
+            continue
+        try:
+            if profile == "uniform":
+                rows = {"alone": fc.seal_leak(tab, p0=pH, L=L, **kw)}
+            else:
+                Rs = np.full(REF_BATCH, R)
+                Rs[1:] *= np.exp(rng.uniform(-0.3, 0.3, REF_BATCH - 1))
+                rows = {"alone": fc.seal_leak(tab, profile="hertz", R=R, f_N=f_N, **kw),
+                        "batch": fc.seal_leak(tab, profile="hertz", R=Rs, f_N=f_N, **kw)}
+        except Exception as e:  # noqa: BLE001 - counted
+            tally.check(path, f"raised {type(e).__name__}", True, str(e)[:160])
+            continue
+        for how, df in rows.items():
+            st = str(df["status"].iloc[0])
+            tally.rows[path] += 1
+            if st != "ok":
+                tally.info[path] += 1
+                continue
+            err = abs(float(df["Q"].iloc[0]) / want - 1.0)
+            key = (path, how)
+            tally.ref_worst[key] = max(tally.ref_worst.get(key, 0.0), err)
+            tally.check(path, f"Q ({how}) off the reference by > {REF_TOL[profile]:g}",
+                        err > REF_TOL[profile], f"rel. err {err:.2e}, p_H/E* {pH / E:.3g}, "
+                        f"p_a/p_H {p_a / pH:.3f}, p_b/p_a {p_b / p_a:.3f}, α p_H {alpha * pH:.3g}")
+
+
+def _flat_reference(rb, rr, visc, sigma0, p0, L, p_a, p_b, alpha, law):
+    """(q [m²/s], solution) of a flat ring by solve_bvp with η(p)."""
+    if visc == "barus":
+        return rb.seal_bvp(sigma0, lambda x: p0 + 0.0 * x, 0.0, L, p_a, p_b, alpha)
+    return rr.seal_bvp(sigma0, lambda x: p0 + 0.0 * x, 0.0, L, p_a, p_b, law)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=4000, help="rows per seal and asperity path")
     ap.add_argument("--n-history", type=int, default=300, help="single cases per history path")
     ap.add_argument("--seed", type=int, default=20261202)
+    ap.add_argument("--n-ref", type=int, default=48, help="seal reference draws")
+    ap.add_argument("--ref-budget", type=float, default=300.0, help="seconds for them")
     ap.add_argument("--out", default=str(HERE / "fuzz_extensions_results.md"))
     args = ap.parse_args(argv)
     warnings.simplefilter("ignore")
@@ -232,6 +337,7 @@ def main(argv=None):
     seal_anisotropic(tally, tab_aniso, rng, args.n)
     histories(tally, tab, rng, args.n_history)
     asperity(tally, tab, rng, args.n)
+    seal_references(tally, tab, rng, args.n_ref, args.ref_budget)
     dt = time.perf_counter() - t0
     rev = subprocess.run(["git", "-C", str(HERE.parent), "rev-parse", "--short", "HEAD"],
                          capture_output=True, text=True).stdout.strip()
@@ -239,7 +345,7 @@ def main(argv=None):
     lines = ["## Fuzz of the extension paths (`bench/bench_fuzz_extensions.py`)", "",
              f"Run {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}: `python "
              f"bench/bench_fuzz_extensions.py --n {args.n} --n-history {args.n_history} --seed "
-             f"{args.seed}` at git {rev}; {cpu_model()}, {os.cpu_count()} cores, Python "
+             f"{args.seed} --n-ref {args.n_ref} --ref-budget {args.ref_budget:g}` at git {rev}; {cpu_model()}, {os.cpu_count()} cores, Python "
              f"{platform.python_version()}; {dt:.0f} s. Tables: embedded asphalt_024mm (every "
              f"theory) and its γ_T = 3 effective-medium build. Rows = outputs checked (histories: "
              f"time points); refused = calls that raised a ValueError naming the input.", "",
@@ -254,7 +360,17 @@ def main(argv=None):
                         for name, k in v.items()) or "0"
         lines.append(f"| {p} | {tally.rows[p]:,} | {tally.refused[p]} | {tally.info[p]} | {txt} |")
     total = sum(tally.viol.values())
-    lines += ["", f"Total violations: {total}.", ""]
+    lines += ["", f"Total violations: {total}.", "",
+              "Worst relative error of Q against the independent references (reference paths "
+              "above: rows = draws evaluated, \"maybe unverified\" column = draws not \"ok\"; "
+              "alone = a call of its own, batch = row 0 of a call of "
+              f"{REF_BATCH} O-rings of one fluid):", "",
+              "| path | call | worst rel. error |", "|---|---|---|"]
+    lines += [f"| {p} | {how} | {e:.2e} |" for (p, how), e in sorted(tally.ref_worst.items())]
+    failed = sum(tally.ref_failed.values())
+    lines += ["", f"Draws whose reference did not converge (scipy; not counted): {failed}"
+              + (f" ({', '.join(f'{p}: {k}' for p, k in sorted(tally.ref_failed.items()))})"
+                 if failed else "") + ".", ""]
     text = "\n".join(lines)
     out = Path(args.out)
     old = out.read_text() if out.is_file() else ""
