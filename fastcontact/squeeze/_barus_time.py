@@ -137,16 +137,17 @@ def refined_rows(pr, rows, aE):
     combined with the base stencil's weights), so that T on the refined rows is the base
     engine's T; only the correction A S is evaluated anew on them. A record with the fields
     ``xn, lnv, lnS, zs, lk, C`` and the base's z grid and tail (as :func:`_build_kernel`
-    reads it); the base rows themselves (as before) where none is inserted."""
+    reads it), every array read-only (one compiled signature whether or not rows were
+    inserted); the base rows themselves (as before) where none is inserted."""
     xn = pr.xn[:rows]
     A_hi = np.minimum(aE * np.exp(xn[1:]), A_ROW_MAX)
     dx_max = DX_G * (API_FAST / np.maximum(A_hi, 1e-300)) ** 0.25
     m = np.maximum(np.ceil(np.diff(xn) / dx_max).astype(np.int64), 1)
     fields = [np.ascontiguousarray(a[:rows]) for a in (pr.lnv, pr.lnS, pr.zs, pr.lk)]
     if np.all(m == 1):
-        return Primitive(np.ascontiguousarray(xn), 0.0, 0.0, np.zeros(0), np.zeros((0, 4)),
-                         pr.z0, pr.dz, pr.nz, np.ascontiguousarray(pr.C[:rows]), *fields,
-                         pr.v_ext, pr.c, pr.d)
+        return readonly_fields(Primitive(
+            np.ascontiguousarray(xn), 0.0, 0.0, np.zeros(0), np.zeros((0, 4)), pr.z0, pr.dz,
+            pr.nz, np.ascontiguousarray(pr.C[:rows]), *fields, pr.v_ext, pr.c, pr.d))
     base = np.cumsum(np.concatenate(([0], m)))          # positions of the base rows
     nr = int(base[-1]) + 1
     xr = np.empty(nr)
@@ -162,8 +163,8 @@ def refined_rows(pr, rows, aE):
     for out, a in zip((lnv, lnS, zs, lk), fields):
         out[base] = a
     _refined_kernel(pr, xr, np.flatnonzero(new), C, lnv, lnS, zs, lk)
-    return Primitive(xr, 0.0, 0.0, np.zeros(0), np.zeros((0, 4)), pr.z0, pr.dz, pr.nz, C,
-                     lnv, lnS, zs, lk, pr.v_ext, pr.c, pr.d)
+    return readonly_fields(Primitive(xr, 0.0, 0.0, np.zeros(0), np.zeros((0, 4)), pr.z0,
+                                     pr.dz, pr.nz, C, lnv, lnS, zs, lk, pr.v_ext, pr.c, pr.d))
 
 
 @njit(parallel=True, cache=True)
