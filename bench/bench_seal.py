@@ -2,8 +2,9 @@
 baselines measured in the same run on this machine.
 
 Writes ``bench/seal_results.md`` (a Markdown fragment for bench/collect.py).
-Run: ``python bench/bench_seal.py [--quick] [--only-pb]`` (``--only-pb``: only the O-rings with
-p_b > 0, their block of the results file replaced).
+Run: ``python bench/bench_seal.py [--quick] [--only-pb] [--only-oils]`` (``--only-pb``: only
+the O-rings with p_b > 0, ``--only-oils``: only the Barus O-rings of one oil per row; their
+block of the results file replaced).
 
 * error: max relative error of Q against ``tests/reference/seal_reference.py`` (direct contact
   core, no tables): flat rings by composite Gauss–Legendre of direct σ_eff over the interval
@@ -19,6 +20,8 @@ p_b > 0, their block of the results file replaced).
   solver (``solver=dict(table=False)``: today's per-case Newton, now on a ``prange`` driver).
 * O-rings with p_b > 0: the p_b > 0 table (steady state, the call that builds it) against
   the per-row solver on the same rows, and the max rel. error of Q against it.
+* Barus O-rings of one oil per row (p_b = 0): the table of W(π_H, π_a, α p_H) likewise, and a
+  call too small to pay for building it.
 """
 from __future__ import annotations
 
@@ -196,10 +199,16 @@ def hertz_pb_section(repeats):
     ok = (ref.status == "ok").to_numpy()
     tab = ok & (first.error_estimate.to_numpy() == fc.seal.hertz.VERIFY_TOL)
     err = float(np.max(np.abs(first.Q[ok] / ref.Q[ok] - 1))) if ok.any() else math.nan
-    lines, cells = int(ht.built.sum()), int((ht.cell > 0).sum())
     return dict(t_first=t_first, t_table=t_table, t_solver=t_solver, err=err,
-                served=float(tab.sum() / max(ok.sum(), 1)), ok=int(ok.sum()), lines=lines,
-                cells=cells, failed=int((ht.cell == 2).sum()),
+                served=float(tab.sum() / max(ok.sum(), 1)), ok=int(ok.sum()),
+                **_table_stats(ht))
+
+
+def _table_stats(ht):
+    """Grid lines solved, cells verified (and failed) and solves of a lazily built O-ring
+    table record (p_b > 0 or one oil per row)."""
+    lines, cells = int(ht.built.sum()), int((ht.cell > 0).sum())
+    return dict(lines=lines, cells=cells, failed=int((ht.cell == 2).sum()),
                 solves=lines * (fastcontact.seal.hertz.NY + 1) + cells)
 
 
@@ -228,16 +237,102 @@ def hertz_pb_lines(p):
     ]
 
 
-def splice_pb(path, block):
-    """Replace the p_b > 0 block (from PB_HEAD to the end of the generated part) of the results
-    file at ``path`` by ``block`` (appended when absent), keeping the rest and its notes."""
+#: Barus O-rings, one oil per row: as PB_N/PB_PH, p_b = 0, α p_H log-uniform in OIL_B
+OIL_N = 200_000
+OIL_B = (1e-3, 1.5)
+OIL_HEAD = "### Barus O-rings, one oil per row (`--only-oils`)"
+
+
+def oils_section(repeats):
+    """Rows/s of Barus O-rings (p_b = 0) whose α differs on every row, from the table of
+    W(π_H, π_a, α p_H) (steady state, the call that builds it, a call too small to pay for it)
+    against the per-row solver, and the max rel. error of Q against it."""
+    import fastcontact.seal.viscosity as sv
+    rng = np.random.default_rng(5)
+    pH = np.exp(rng.uniform(math.log(PB_PH[0]), math.log(PB_PH[1]), OIL_N)) * E
+    pa = rng.uniform(1e-3, 0.999, OIL_N) * pH
+    alpha = np.exp(rng.uniform(math.log(OIL_B[0]), math.log(OIL_B[1]), OIL_N)) / pH
+    kw = dict(profile="hertz", R=R, f_N=math.pi * R * pH ** 2 / E, dp=pa, L_y=L_Y,
+              E_star=E, eta=ETA, alpha_cj=ALPHA, alpha_pv=alpha)
+    fresh = fc.Tables.from_parquet(TABLE_FILE)
+    fc.seal_leak(fresh, p0=5e4, dp=1e3, L=L, L_y=L_Y, E_star=E, eta=ETA)   # the context
+    small = {**kw, **{k: kw[k][:20_000] for k in ("f_N", "dp", "alpha_pv")}}
+    t0 = time.perf_counter()
+    fc.seal_leak(fresh, **small)
+    t_small = time.perf_counter() - t0
+    sc = fc.seal.context.seal_context(fresh, "critical_junction")
+    small_built = bool(fastcontact.seal.hertz.hertz_beta_table(sc).rec.built.any())
+    t0 = time.perf_counter()
+    first = fc.seal_leak(fresh, **kw)
+    t_first = time.perf_counter() - t0
+    t_table = median_time(lambda: fc.seal_leak(fresh, **kw), repeats)
+    keep = sv.TABLE_MIN_ROWS
+    sv.TABLE_MIN_ROWS = 10 ** 12             # every row solved
+    try:
+        t0 = time.perf_counter()
+        ref = fc.seal_leak(fresh, **kw)
+        t_solver = time.perf_counter() - t0
+    finally:
+        sv.TABLE_MIN_ROWS = keep
+    base = median_time(lambda: fc.seal_leak(fresh, **{k: v for k, v in kw.items()
+                                                      if k != "alpha_pv"}), repeats)
+    ht = fastcontact.seal.hertz.hertz_beta_table(sc).rec
+    ok = (ref.status == "ok").to_numpy()
+    same = ok & (first.Q.to_numpy() == ref.Q.to_numpy())      # rows the solver gave
+    err = float(np.max(np.abs(first.Q[ok] / ref.Q[ok] - 1))) if ok.any() else math.nan
+    return dict(t_first=t_first, t_table=t_table, t_solver=t_solver, t_small=t_small,
+                small_built=small_built, base=base, err=err,
+                served=1.0 - float(same.sum() / max(ok.sum(), 1)), ok=int(ok.sum()),
+                **_table_stats(ht))
+
+
+def oils_lines(p):
+    """The Markdown block of :func:`oils_section`."""
+    n = OIL_N
+    return [
+        OIL_HEAD,
+        "",
+        f"{n:,} Barus O-rings, each of its own oil: α p_H log-uniform in {list(OIL_B)}, p_H/E* "
+        f"log-uniform in {list(PB_PH)}, p_a/p_H uniform in [1e-3, 0.999], p_b = 0 (critical "
+        f"junction, α_cj = {ALPHA}); {p['ok']:,} rows status \"ok\", {p['served'] * 100:.2f} % "
+        f"of them served by the table of W(π_H, π_a, α p_H) "
+        f"(`fastcontact.seal.hertz.table_W_beta`, α p_H <= {fastcontact.seal.hertz.B_MAX}). "
+        f"Table built by the first call: {p['lines']:,} grid lines (ln π_H, α p_H) of "
+        f"{fastcontact.seal.hertz.NY + 1} nodes and {p['cells']:,} cells verified "
+        f"({p['failed']:,} failed: solver), {p['solves']:,} solves at the table tolerance.",
+        "",
+        "| path | end-to-end rows/s | × solver | max rel. error of Q vs solver |",
+        "|---|---|---|---|",
+        f"| table (steady state, table kept) | {n / p['t_table']:.3g} | "
+        f"{p['t_solver'] / p['t_table']:.3g} | {p['err']:.1e} |",
+        f"| table, first call (builds it: lines + verification) | {n / p['t_first']:.3g} | "
+        f"{p['t_solver'] / p['t_first']:.3g} | same rows |",
+        f"| per-row solver (`TABLE_MIN_ROWS` raised, prange) | {n / p['t_solver']:.3g} | 1 | – |",
+        f"| base fluid (α = 0) on the same O-rings, its table | {n / p['base']:.3g} | "
+        f"{p['t_solver'] / p['base']:.3g} | – |",
+        "",
+        f"A first call of 20,000 of these rows (fresh tables) "
+        f"{'built the table' if p['small_built'] else 'did not build the table (it would take more solves than the rows: solved per row)'}"
+        f": {20_000 / p['t_small']:.3g} rows/s.",
+        "",
+    ]
+
+
+def splice_block(path, head, block):
+    """Replace the block from ``head`` to the next generated block head (### that is one of
+    PB_HEAD, OIL_HEAD) or the end of the generated part of the results file at ``path`` by
+    ``block`` (appended when absent), keeping the rest (:func:`write_keeping_notes` keeps
+    the notes)."""
     from results_notes import NOTES_MARK
     text = Path(path).read_text() if Path(path).is_file() else ""
     lines = text.splitlines()
     end = next((i for i, ln in enumerate(lines) if ln.startswith(NOTES_MARK)), len(lines))
     gen = lines[:end]
-    if PB_HEAD in gen:
-        gen = gen[:gen.index(PB_HEAD)]
+    if head in gen:
+        i = gen.index(head)
+        j = next((k for k in range(i + 1, len(gen)) if gen[k] in (PB_HEAD, OIL_HEAD)),
+                 len(gen))
+        gen = gen[:i] + gen[j:]
     return "\n".join(gen).rstrip() + "\n\n" + "\n".join(block)
 
 
@@ -250,6 +345,9 @@ def main():
     ap.add_argument("--only-pb", action="store_true",
                     help="run only the O-rings with p_b > 0 and replace their block in "
                          "seal_results.md (the other sections are kept as they are)")
+    ap.add_argument("--only-oils", action="store_true",
+                    help="run only the Barus O-rings of one oil per row and replace their "
+                         "block in seal_results.md")
     args = ap.parse_args()
     repeats = 3 if args.quick else 5
     load0 = os.getloadavg()
@@ -258,16 +356,21 @@ def main():
     tables = fc.precompute(psd)
     t_pre = time.perf_counter() - t0
     tables.to_parquet(TABLE_FILE)
-    if args.only_pb:
-        block = hertz_pb_lines(hertz_pb_section(repeats))
-        block[2] += (f" {machine()}; load average {tuple(round(x, 2) for x in load0)} at the "
-                     f"start, {tuple(round(x, 2) for x in os.getloadavg())} at the end.")
-        write_keeping_notes(HERE / "seal_results.md", splice_pb(HERE / "seal_results.md", block))
-        print("\n".join(block))
+    for flag, head, run in ((args.only_pb, PB_HEAD, lambda: hertz_pb_lines(
+            hertz_pb_section(repeats))), (args.only_oils, OIL_HEAD,
+                                          lambda: oils_lines(oils_section(repeats)))):
+        if flag:
+            block = run()
+            block[2] += (f" {machine()}; load average {tuple(round(x, 2) for x in load0)} at "
+                         f"the start, {tuple(round(x, 2) for x in os.getloadavg())} at the end.")
+            write_keeping_notes(HERE / "seal_results.md",
+                                splice_block(HERE / "seal_results.md", head, block))
+            print("\n".join(block))
+    if args.only_pb or args.only_oils:
         return
     u = uniform_section(tables, psd, args.quick, repeats)
     h = hertz_section(tables, psd, args.quick, repeats)
-    pb = hertz_pb_lines(hertz_pb_section(repeats))
+    pb = hertz_pb_lines(hertz_pb_section(repeats)) + oils_lines(oils_section(repeats))
     load1 = os.getloadavg()
     md = [
         "## Seal leak rate — `bench/bench_seal.py`",

@@ -18,7 +18,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["ra_of_y", "y_of", "z_of", "hertz_interp", "pb_cells", "hertz_pb_interp"]
+__all__ = ["ra_of_y", "y_of", "z_of", "hertz_interp", "pb_cells", "hertz_pb_interp", "z_cells",
+           "hertz_z_interp"]
 
 
 @njit(cache=True)
@@ -168,3 +169,25 @@ def hertz_pb_interp(ht, piH, pia, pib, rows, force, lnW):
         w3 = np.empty(6)
         lnW[i] = _interp_pb_one(ht, math.log(piH[i]), y_of(piH[i], pia[i]),
                                 z_of(piH[i], pia[i], pib[i]), force, w1, w2, w3)
+
+
+# ------------------------------------------------- a third coordinate given per row
+@njit(cache=True, parallel=True)
+def z_cells(ht, piH, pia, z, rows, k, j, m):
+    """:func:`pb_cells` with the third coordinate ``z`` ∈ [0, 1] given per row (the Barus
+    b/B_MAX of :func:`~.hertz.table_W_beta`)."""
+    for jj in prange(rows.size):
+        i = rows[jj]
+        k[jj], j[jj], m[jj], _ = _pb_cell(ht, math.log(piH[i]), y_of(piH[i], pia[i]), z[i])
+
+
+@njit(cache=True, parallel=True)
+def hertz_z_interp(ht, piH, pia, z, rows, force, lnW):
+    """:func:`hertz_pb_interp` with the third coordinate ``z`` given per row."""
+    for jj in prange(rows.size):
+        i = rows[jj]
+        w1 = np.empty(6)
+        w2 = np.empty(6)
+        w3 = np.empty(6)
+        lnW[i] = _interp_pb_one(ht, math.log(piH[i]), y_of(piH[i], pia[i]), z[i], force,
+                                w1, w2, w3)

@@ -235,6 +235,7 @@ class SealContext:
         self.hertz_piezo = {}        # O-ring tables of Barus fluids by α̃ = α E* (the same)
         self.hertz_pb = None         # the O-ring table for p_b > 0 (hertz.HertzPbTable holder)
         self.hertz_pb_piezo = {}     # its tables of Barus/Roelands fluids (the same keys)
+        self.hertz_beta = None       # Barus O-rings, p_b = 0, α per row (hertz.table_W_beta)
         self.build_seconds = time.perf_counter() - t_start
 
 

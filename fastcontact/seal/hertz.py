@@ -21,6 +21,12 @@ the :class:`SealContext`; a Barus fluid's tables (α̃ = α E*, η = η0 e^{α(p
 and one E* make W a function of (π_H, π_a, π_b) again) the same way, per α̃, the solver run
 with that α̃; a Roelands fluid's per law (A, Z, p_r/E*); the last PIEZO_TABLES fluids of each
 kind of table are kept.
+
+Barus O-rings whose fluids differ from row to row (a study over oils, each with too few rows
+for a table of its own) read, for p_b = 0, one more table (:func:`table_W_beta`): ln W on a
+grid in (ln π_H, y, b), b = α p_H = α̃ π_H ∈ [0, B_MAX] the third coordinate (the same record
+and lazy, verified line-by-line filling as the p_b > 0 table); rows past B_MAX, and with
+p_b > 0, are solved.
 """
 from __future__ import annotations
 
@@ -34,7 +40,8 @@ from . import _hertz, _panels
 from .context import RowsOut, panel_rule, solver_options
 
 __all__ = ["HertzTable", "hertz_table", "table_W", "HertzPbTable", "hertz_pb_table", "table_W_pb",
-           "tabled_W", "H1", "NY", "NZ", "TABLE_TOL", "VERIFY_TOL"]
+           "tabled_W", "hertz_beta_table", "table_W_beta", "H1", "NY", "NZ", "NB", "B_MAX",
+           "TABLE_TOL", "VERIFY_TOL"]
 
 #: grid spacing in ln π_H, number of y intervals
 H1 = 0.05
@@ -111,11 +118,12 @@ def _empty_table(sc):
 
 
 def _solve_W(sc, piH, pia, equal, al=0.0, vis=None, pib=None):
-    """W of (π_H, π_a, π_b) points (``pib`` None: p_b = 0; Barus α̃ = ``al``, or the Roelands
-    law ``vis``) with the table's tight solver settings; ``equal``: the points at the lift-off
+    """W of (π_H, π_a, π_b) points (``pib`` None: p_b = 0; Barus α̃ = ``al``, one or per point,
+    or the Roelands law ``vis``) with the table's tight solver settings; ``equal``: the points at the lift-off
     equality p_a = p_H (panel tolerance 1e-9)."""
     pib = np.zeros(piH.size) if pib is None else np.ascontiguousarray(pib, dtype=np.float64)
     o = solver_options(None)
+    alr = np.array(np.broadcast_to(np.asarray(al, dtype=np.float64), (piH.size,)))  # per point
     out = RowsOut.empty(piH.size)
     law = (np.zeros((piH.size, 0)) if vis is None
            else np.ascontiguousarray(np.tile(np.asarray(vis, dtype=np.float64), (piH.size, 1))))
@@ -126,7 +134,7 @@ def _solve_W(sc, piH, pia, equal, al=0.0, vis=None, pib=None):
         rule = panel_rule(o, tol=1e-9 if eq else TABLE_TOL, max_panels=256)
         _panels.solve_rows(sc.tab, sc.rec, rule, 0, np.zeros(2), np.zeros(2),
                            np.ascontiguousarray(piH), np.ascontiguousarray(pia),
-                           pib, np.full(piH.size, float(al)), law,
+                           pib, alr, law,
                            idx.astype(np.int64), out)
     return np.where(out.status == _panels.ST_NEWTON_FAILED, np.nan, out.W)
 
@@ -252,13 +260,13 @@ class _PbBox:
 
     __slots__ = ("rec",)
 
-    def __init__(self, sc):
+    def __init__(self, sc, nz=NZ):
         t0 = sc.rec.t_lo - 3.0
         K = int(math.ceil((math.log(sc.p_top) - t0) / H1)) + 1
         self.rec = HertzPbTable(t0, H1, np.full(K, -1, dtype=np.int64),
-                                np.zeros((0, NZ + 1, NY + 1)),
-                                np.zeros((0, NZ, NY), dtype=np.int8),
-                                np.zeros((0, NZ + 1), dtype=np.bool_))
+                                np.zeros((0, nz + 1, NY + 1)),
+                                np.zeros((0, nz, NY), dtype=np.int8),
+                                np.zeros((0, nz + 1), dtype=np.bool_))
 
 
 def hertz_pb_table(sc, al=0.0, vis=None):
@@ -281,23 +289,26 @@ def _with_planes(ht, ks):
     slot = ht.slot.copy()
     slot[new] = ht.lw.shape[0] + np.arange(new.size)
     n = new.size
+    nz = ht.cell.shape[1]
     return ht._replace(
-        slot=slot, lw=np.concatenate((ht.lw, np.full((n, NZ + 1, NY + 1), np.nan))),
-        cell=np.concatenate((ht.cell, np.zeros((n, NZ, NY), dtype=np.int8))),
-        built=np.concatenate((ht.built, np.zeros((n, NZ + 1), dtype=np.bool_))))
+        slot=slot, lw=np.concatenate((ht.lw, np.full((n, nz + 1, NY + 1), np.nan))),
+        cell=np.concatenate((ht.cell, np.zeros((n, nz, NY), dtype=np.int8))),
+        built=np.concatenate((ht.built, np.zeros((n, nz + 1), dtype=np.bool_))))
 
 
-def _stencil_lines(kc, mc):
-    """Grid lines (k(NZ + 1) + m) of the 6×6 (ln π_H, z) stencils of cells (kc, mc)."""
-    ms = np.clip(mc - 2, 0, NZ - 5)
+def _stencil_lines(kc, mc, nz=NZ):
+    """Grid lines (k(nz + 1) + m) of the 6×6 (ln π_H, z) stencils of cells (kc, mc) of a
+    table of nz intervals in its third coordinate."""
+    ms = np.clip(mc - 2, 0, nz - 5)
     k = kc[:, None, None] + np.arange(-2, 4)[None, :, None]
     m = ms[:, None, None] + np.arange(6)[None, None, :]
-    return np.unique((k * (NZ + 1) + m).ravel())
+    return np.unique((k * (nz + 1) + m).ravel())
 
 
 def _unbuilt(ht, lines):
     """Number of the grid lines not solved yet."""
-    return int((~_on_planes(ht.built, ht.slot[lines // (NZ + 1)], lines % (NZ + 1))).sum())
+    n1 = ht.cell.shape[1] + 1
+    return int((~_on_planes(ht.built, ht.slot[lines // n1], lines % n1)).sum())
 
 
 def _on_planes(a, s, *idx):
@@ -308,13 +319,28 @@ def _on_planes(a, s, *idx):
     return out
 
 
-def _build_lines(sc, ht, lines, al=0.0, vis=None):
-    """``ht`` with the grid lines solved (all y nodes; planes added as needed)."""
-    kl, ml = lines // (NZ + 1), lines % (NZ + 1)
+def _lines_to_solve(ht, lines):
+    """(``ht`` with planes for the grid lines, and of those not solved yet: grid row k, third
+    coordinate's node m, plane s)."""
+    n1 = ht.cell.shape[1] + 1
+    kl, ml = lines // n1, lines % n1
     ht = _with_planes(ht, kl)
     s = ht.slot[kl]
     todo = ~ht.built[s, ml]
-    kl, ml, s = kl[todo], ml[todo], s[todo]
+    return ht, kl[todo], ml[todo], s[todo]
+
+
+def _store_lines(ht, s, ml, W):
+    """Keep ln W of the solved lines (planes s, nodes ml; W of all NY + 1 y nodes each)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ht.lw[s, ml] = np.log(W).reshape(s.size, NY + 1)
+    ht.built[s, ml] = True
+    return ht
+
+
+def _build_lines(sc, ht, lines, al=0.0, vis=None):
+    """``ht`` with the grid lines solved (all y nodes; planes added as needed)."""
+    ht, kl, ml, s = _lines_to_solve(ht, lines)
     if not kl.size:
         return ht
     r = _r_nodes()
@@ -324,10 +350,7 @@ def _build_lines(sc, ht, lines, al=0.0, vis=None):
     piH = np.repeat(np.exp(ht.t0 + ht.h1 * kl), NY + 1)
     W = _solve_W(sc, piH, np.tile(r, kl.size) * piH,
                  np.tile(np.arange(NY + 1) == NY, kl.size), al, vis, rb.ravel() * piH)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ht.lw[s, ml] = np.log(W).reshape(kl.size, NY + 1)
-    ht.built[s, ml] = True
-    return ht
+    return _store_lines(ht, s, ml, W)
 
 
 def _verify_pb_cells(sc, ht, kc, mc, jc, al=0.0, vis=None):
@@ -397,3 +420,77 @@ def tabled_W(sc, piH, pia, pib, rows, zero, al=0.0, vis=None, budget_zero=False)
     for r, W in read:
         out[r] = W[r]
     return out
+
+
+# ===================================================== Barus, one α per row (p_b = 0)
+#: the third coordinate of the O-ring table of Barus fluids given one per row: b = α p_H =
+#: α̃ π_H on [0, B_MAX] in NB uniform intervals (Δb = 0.25). Measured at π_H = 2e-3, 0.01,
+#: 0.04 and p_a/p_H = 1e-3 … 0.99 (critical junction): ln W is smooth in b, its 6-point
+#: Lagrange interpolation within 7e-8 of the solver at every cell centre (5.6e-7 with
+#: Δb = 0.5, 4e-6 with Δb = 0.67); past b ~ 5 the solver itself fails next to lift-off
+B_MAX = 4.0
+NB = 16
+
+
+def hertz_beta_table(sc):
+    """The (lazily filled) table holder of a SealContext for Barus O-rings with p_b = 0 and
+    any α per row: ln W on a grid in (ln π_H, y, b/B_MAX), b = α p_H (a
+    :class:`HertzPbTable` record with NB intervals in its third coordinate)."""
+    return _kept(sc, "hertz_beta", None, 0.0, None, lambda c: _PbBox(c, NB))
+
+
+def _build_beta_lines(sc, ht, lines):
+    """``ht`` with the grid lines (k, b_m) solved (all y nodes; α̃ = b_m/π_H per line)."""
+    ht, kl, ml, s = _lines_to_solve(ht, lines)
+    if not kl.size:
+        return ht
+    r = _r_nodes()
+    piHk = np.exp(ht.t0 + ht.h1 * kl)
+    piH = np.repeat(piHk, NY + 1)
+    al = np.repeat(ml / NB * B_MAX / piHk, NY + 1)
+    W = _solve_W(sc, piH, np.tile(r, kl.size) * piH,
+                 np.tile(np.arange(NY + 1) == NY, kl.size), al)
+    return _store_lines(ht, s, ml, W)
+
+
+def _verify_beta_cells(sc, ht, kc, mc, jc):
+    """Solve at the centres of cells (kc, b cell mc, jc) and compare with the interpolation."""
+    piH = np.exp(ht.t0 + ht.h1 * (kc + 0.5))
+    pia = piH * _ra((jc + 0.5) / NY)
+    z = (mc + 0.5) / NB
+    est = np.empty(kc.size)
+    _hertz.hertz_z_interp(ht, piH, pia, z, np.arange(kc.size, dtype=np.int64), True, est)
+    ht.cell[ht.slot[kc], mc, jc] = np.where(
+        _verified(sc, piH, pia, None, est, z * B_MAX / piH, None), 1, 2)
+
+
+def table_W_beta(sc, piH, pia, al, rows, max_solves=None):
+    """W [-] of Barus O-ring rows with p_b = 0 and one reduced coefficient α̃ = α E* per row
+    (``al``), below lift-off (π_a < π_H), from the table of (π_H, π_a, b = α̃ π_H); NaN where
+    the solver must be used (b > B_MAX, cells not verified). As :func:`table_W_pb`: the grid
+    lines (k, b_m) the rows' cells need are solved (NY + 1 solves each) and the cells verified
+    at their centre (one solve each) first; ``max_solves``: None (and no table read) where
+    that would take more solves."""
+    piH, pia = (np.array(x, dtype=np.float64) for x in (piH, pia))
+    rows = np.array(rows, dtype=np.int64)
+    z = np.zeros(piH.size)
+    z[rows] = np.asarray(al, dtype=np.float64)[rows] * piH[rows] / B_MAX
+    box = hertz_beta_table(sc)
+    with _LOCK:
+        ht = box.rec
+        k, j, m = (np.empty(rows.size, dtype=np.int64) for _ in range(3))
+        _hertz.z_cells(ht, piH, pia, z, rows, k, j, m)
+        inside = (k >= 2) & (k <= ht.slot.size - 4) & (z[rows] <= 1.0)
+        cells = np.unique((k[inside] * NB + m[inside]) * NY + j[inside])
+        kc, mc, jc = cells // (NB * NY), (cells // NY) % NB, cells % NY
+        todo = _on_planes(ht.cell, ht.slot[kc], mc, jc) == 0
+        if todo.any():
+            lines = _stencil_lines(kc[todo], mc[todo], NB)
+            if (max_solves is not None
+                    and _unbuilt(ht, lines) * (NY + 1) + int(todo.sum()) > max_solves):
+                return None
+            ht = box.rec = _build_beta_lines(sc, ht, lines)
+            _verify_beta_cells(sc, ht, kc[todo], mc[todo], jc[todo])
+    lnW = np.full(piH.size, np.nan)
+    _hertz.hertz_z_interp(ht, piH, pia, z, rows[inside], False, lnW)
+    return np.exp(lnW)

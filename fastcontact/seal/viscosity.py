@@ -690,7 +690,37 @@ def _barus_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, alpha):
         return _hertz_k_tabled(tables, theory, *sub[:5], key[0], None, lambda j: psia[j],
                                lambda j: _barus_hertz_k(tables, theory, *(x[j] for x in sub)))
     return _by_fluid((al,), al > 0.0, one_fluid,
-                     lambda i: _barus_hertz_k(tables, theory, *(x[i] for x in args)))
+                     lambda i: _barus_hertz_k_any(tables, theory, *(x[i] for x in args)))
+
+
+def _barus_hertz_k_any(tables, theory, E, pH, a, pa, pb, alpha):
+    """:func:`_barus_hertz_k` of Barus O-rings whose fluids differ from row to row (none with
+    a table of its own): the rows with p_b = 0 and 0 < α p_H <= B_MAX below lift-off, at
+    least TABLE_MIN_ROWS of them, from the verified table of W(π_H, π_a, α p_H)
+    (:func:`fastcontact.seal.hertz.table_W_beta`, kept with the seal context) where completing
+    it costs no more solves than those rows; every other row, and the rows whose cells are
+    not verified, by the solver."""
+    from .hertz import B_MAX, table_W_beta
+    n = E.size
+    elig = np.flatnonzero((pb == 0.0) & (alpha > 0.0) & (pa < pH) & (alpha * pH <= B_MAX))
+    W = None
+    if elig.size >= TABLE_MIN_ROWS:
+        W = table_W_beta(seal_context(tables, theory), pH / E, pa / E, alpha * E, elig,
+                         max_solves=elig.size)
+    if W is None:
+        return _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha)
+    fast = elig[np.isfinite(W[elig])]
+    solve = np.ones(n, dtype=bool)
+    solve[fast] = False
+    rest = np.flatnonzero(solve)
+    k = np.empty(n)
+    ok = np.ones(n, dtype=bool)
+    al, dp = alpha[fast], pa[fast] - pb[fast]
+    k[fast] = -np.expm1(-al * dp) / al / (a[fast] * W[fast])   # ψ_a/(a W), α > 0 here
+    if rest.size:
+        k[rest], ok[rest] = _barus_hertz_k(tables, theory, *(x[rest] for x in
+                                                           (E, pH, a, pa, pb, alpha)))
+    return k, ok
 
 
 def _roelands_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, A, Z, pr):
