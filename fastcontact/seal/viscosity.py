@@ -701,25 +701,29 @@ def _barus_hertz_k_any(tables, theory, E, pH, a, pa, pb, alpha):
     it costs no more solves than those rows; every other row, and the rows whose cells are
     not verified, by the solver."""
     from .hertz import B_MAX, table_W_beta
-    n = E.size
     elig = np.flatnonzero((pb == 0.0) & (alpha > 0.0) & (pa < pH) & (alpha * pH <= B_MAX))
     W = None
     if elig.size >= TABLE_MIN_ROWS:
         W = table_W_beta(seal_context(tables, theory), pH / E, pa / E, alpha * E, elig,
                          max_solves=elig.size)
+    args = (E, pH, a, pa, pb, alpha)
     if W is None:
-        return _barus_hertz_k(tables, theory, E, pH, a, pa, pb, alpha)
-    fast = elig[np.isfinite(W[elig])]
-    solve = np.ones(n, dtype=bool)
-    solve[fast] = False
-    rest = np.flatnonzero(solve)
-    k = np.empty(n)
-    ok = np.ones(n, dtype=bool)
-    al, dp = alpha[fast], pa[fast] - pb[fast]
-    k[fast] = -np.expm1(-al * dp) / al / (a[fast] * W[fast])   # ψ_a/(a W), α > 0 here
+        return _barus_hertz_k(tables, theory, *args)
+    return _k_from_W(W, a, lambda j: -np.expm1(-alpha[j] * (pa[j] - pb[j])) / alpha[j],
+                     lambda j: _barus_hertz_k(tables, theory, *(x[j] for x in args)))
+
+
+def _k_from_W(W, a, psia, solve):
+    """(k [Pa/m], converged): k = ψ_a/(a W) on the rows with a finite tabled W, ``psia(j)`` the
+    rows' ψ_a [Pa]; ``solve(j)`` -> (k, converged) of the others (NaN W: not tabled)."""
+    fast = np.flatnonzero(np.isfinite(W))
+    rest = np.flatnonzero(~np.isfinite(W))
+    k = np.empty(W.size)
+    ok = np.ones(W.size, dtype=bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k[fast] = psia(fast) / (a[fast] * W[fast])
     if rest.size:
-        k[rest], ok[rest] = _barus_hertz_k(tables, theory, *(x[rest] for x in
-                                                           (E, pH, a, pa, pb, alpha)))
+        k[rest], ok[rest] = solve(rest)
     return k, ok
 
 
@@ -783,15 +787,7 @@ def _hertz_k_tabled(tables, theory, E, pH, a, pa, pb, al, vis, psia, solve):
                  np.flatnonzero(pa < pH), pb == 0.0, al, vis, budget_zero=True)
     if W is None:
         return solve(np.arange(n))
-    fast = np.flatnonzero(np.isfinite(W))
-    rest = np.flatnonzero(~np.isfinite(W))
-    k = np.empty(n)
-    ok = np.ones(n, dtype=bool)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k[fast] = psia(fast) / (a[fast] * W[fast])
-    if rest.size:
-        k[rest], ok[rest] = solve(rest)
-    return k, ok
+    return _k_from_W(W, a, psia, solve)
 
 
 #: fewest O-ring rows of one fluid (Barus or Roelands; in a call of several fluids, of each)
