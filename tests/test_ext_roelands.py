@@ -218,3 +218,40 @@ def test_hertz_default_is_the_panel_collocation(tables, monkeypatch):
         for k, d in enumerate(dp):
             ref = hertz_shoot(_sigma(tables, theory), pH, a, d, 0.0, roelands(ETA, Z, C)) * L_Y
             assert abs(got.Q[k] / ref - 1) < 2e-8, (theory, d / pH, got.Q[k] / ref - 1)
+
+
+def test_one_law_drops_share_one_table_against_quad():
+    """Rows of one Roelands fluid read ψ(Δπ) from one table reaching the largest drop
+    (``psi_drops_one_law``, the O-ring tables' ψ_a), against scipy quad of the law written out,
+    from drops 1e-6 of the largest to the largest: within 1e-11; where that one table would
+    need more than PSI_MAX_NODES nodes (a steep law over a large drop) ``one_table_fits`` says
+    no and each row keeps its own table (``psi_drops``)."""
+    from scipy.integrate import quad
+
+    from fastcontact.seal._roelands_psi import (PSI_MAX_NODES, one_table_fits, psi_drops,
+                                                psi_drops_one_law, psi_table)
+
+    E = 1e7
+    for eta0, z, pr, top in ((1e-3, 0.6, 2e5, 3e5), (0.1, 0.6, ROELANDS_P_R, 5e7),
+                             (0.5, 0.68, 1e5, 2e5)):
+        A = math.log(eta0 / ROELANDS_ETA_INF)
+        law = roelands(eta0, z, 1.0 / pr)
+        dp = top * np.concatenate((np.geomspace(1e-6, 1.0, 9), [0.37, 0.81]))
+        assert one_table_fits(A, z, pr / E, top / E)
+        got = np.empty(dp.size)
+        psi_drops_one_law(A, z, pr / E, dp / E, got)
+        for p, g in zip(dp, got):
+            ref = quad(lambda x: 1.0 / law(x), 0.0, p, epsabs=0.0, epsrel=1e-13,
+                       limit=200)[0] / E
+            assert abs(g / ref - 1) < 1e-11, (eta0, z, pr, p)
+    # steep: p_r = 0.1 MPa, η0 = 0.5 Pa s, over 100 MPa — the largest drop's table is capped
+    A = math.log(0.5 / ROELANDS_ETA_INF)
+    assert psi_table(A, 0.68, 1e5 / E, 1e8 / E).y.size - 1 == PSI_MAX_NODES
+    assert not one_table_fits(A, 0.68, 1e5 / E, 1e8 / E)
+    assert one_table_fits(A, 0.68, 1e5 / E, 1e6 / E)
+    dpi = np.array([1e6, 1e8]) / E
+    own = np.empty(2)
+    psi_drops(np.full(2, A), np.full(2, 0.68), np.full(2, 1e5 / E), dpi, own)
+    law = roelands(0.5, 0.68, 1e-5)
+    ref = quad(lambda x: 1.0 / law(x), 0.0, 1e6, epsabs=0.0, epsrel=1e-13, limit=200)[0] / E
+    assert abs(own[0] / ref - 1) < 1e-11

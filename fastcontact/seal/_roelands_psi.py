@@ -26,13 +26,13 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from ..kernels.hermite import quintic_unit
 from ..kernels.quadrature import gauss_legendre
 
 __all__ = ["PsiTable", "psi_table", "no_psi_table", "psi_of", "psi_eta", "fluid_of", "psi_drops",
-           "PSI_CELL", "PSI_STEEP", "PSI_REACH"]
+           "one_table_fits", "psi_drops_one_law", "PSI_CELL", "PSI_STEEP", "PSI_REACH"]
 
 #: a table of ψ(π): the law (A, Z, π_r), the node width h in u = ln(1 + π/π_r), the values
 #: y = ψ, g = dψ/du and s = d²ψ/du² at the nodes u_k = k h (size 0: no Roelands fluid)
@@ -56,12 +56,20 @@ def _g(u, A, Z, pr):
 
 
 @njit(cache=True)
+def _nodes_wanted(A, Z, pr, dpi):
+    """(u_max, cells) a table reaching PSI_REACH·dpi needs for its node width (before the
+    PSI_MAX_NODES cap)."""
+    umax = math.log1p(PSI_REACH * max(dpi, 0.0) / pr)
+    steep = PSI_STEEP / (1.0 + A * Z * math.exp(Z * umax))
+    return umax, max(1, int(math.ceil(umax / min(PSI_CELL, steep))))
+
+
+@njit(cache=True)
 def psi_table(A, Z, pr, dpi):
     """The :data:`PsiTable` of the law (A, Z, π_r) for fluid pressures 0 .. PSI_REACH·dpi
     above the outlet (reduced)."""
-    umax = math.log1p(PSI_REACH * max(dpi, 0.0) / pr)
-    steep = PSI_STEEP / (1.0 + A * Z * math.exp(Z * umax))
-    n = min(PSI_MAX_NODES, max(1, int(math.ceil(umax / min(PSI_CELL, steep)))))
+    umax, n = _nodes_wanted(A, Z, pr, dpi)
+    n = min(PSI_MAX_NODES, n)
     h = umax / n if umax > 0.0 else 1.0
     y = np.empty(n + 1)
     g = np.empty(n + 1)
@@ -147,3 +155,37 @@ def psi_drops(A, Z, pr, dpi, out):
     table the solver builds for the row."""
     for i in range(dpi.size):
         out[i] = psi_of(psi_table(A[i], Z[i], pr[i], dpi[i]), dpi[i])
+
+
+@njit(cache=True)
+def one_table_fits(A, Z, pr, dpi_max):
+    """Whether one table of the law (A, Z, π_r) reaching the largest drop ``dpi_max`` keeps
+    the node width every smaller drop's own table would have (it needs no more than
+    PSI_MAX_NODES nodes: the width bound min(PSI_CELL, PSI_STEEP/(1 + A Z e^{Z u_max}))
+    only tightens as u_max grows)."""
+    return _nodes_wanted(A, Z, pr, dpi_max)[1] <= PSI_MAX_NODES
+
+
+@njit(cache=True)
+def _psi_of_parts(A, Z, pr, h, y, g, s, pi):
+    """:func:`psi_of` of the table given by its fields (a parallel loop cannot name the
+    namedtuple itself)."""
+    return psi_of(PsiTable(A, Z, pr, h, y, g, s), pi)
+
+
+@njit(cache=True, parallel=True)
+def _read_one_table(A, Z, pr, h, y, g, s, dpi, out):
+    for i in prange(dpi.size):
+        out[i] = _psi_of_parts(A, Z, pr, h, y, g, s, dpi[i])
+
+
+@njit(cache=True)
+def psi_drops_one_law(A, Z, pr, dpi, out):
+    """ψ(Δπ) of rows sharing one law (A, Z, π_r; scalars, reduced) into ``out``: one table
+    reaching the largest drop (node width no larger than each row's own table's bound, where
+    :func:`one_table_fits`; the same quintic Hermite), read in parallel."""
+    top = 0.0
+    for i in range(dpi.size):
+        top = max(top, dpi[i])
+    rt = psi_table(A, Z, pr, top)
+    _read_one_table(rt.A, rt.Z, rt.pr, rt.h, rt.y, rt.g, rt.s, dpi, out)
