@@ -142,7 +142,8 @@ def test_roelands_table_against_the_solver(tables, monkeypatch):
     """A Roelands fluid's O-rings (one law, Δp sweeps of 4 O-rings, 6,000 rows; the table
     keyed by the law (A, Z, p_r/E*)): Q within 1e-7 of the per-row solver, the same
     statuses, most rows from the table; a call of two laws (3,000 rows each): the first law's
-    rows from its kept table (its call's numbers exactly), every row within 1e-7 of the
+    rows from its kept table (its call's numbers to round-off: W is the kept table's, ψ_a is
+    read from one ψ table reaching each call's largest drop), every row within 1e-7 of the
     solver."""
     kw, _pH, _a = _orings(6000, 3, 4e-6, designs=4)
     kw.update(theory="emt", viscosity="roelands", roelands_z=0.6, roelands_p_r=2e5)
@@ -169,7 +170,7 @@ def test_roelands_table_against_the_solver(tables, monkeypatch):
     two = dict(kw, roelands_z=np.where(even, 0.6, 0.5))          # two laws, 3,000 rows each
     got2 = seal_leak_piezo(tables, **two)
     assert 0.6 in [c[0][1] for c in calls]                     # the first law's kept table
-    np.testing.assert_array_equal(got2.Q[even], got.Q[even])
+    np.testing.assert_allclose(got2.Q[even], got.Q[even], rtol=1e-13, atol=0)
     ref2 = _solver_only(tables, two, monkeypatch)
     ok2 = (ref2.status == "ok").to_numpy()
     assert list(got2.status) == list(ref2.status) and ok2.sum() > 5000
