@@ -14,9 +14,12 @@ a time), whose compiles go to the same cache.
 
 Groups (:data:`GROUPS`): ``tables`` (precompute), ``squeeze`` (squeeze_out by the time
 primitive and by per-case quadrature, squeeze_history), ``tire`` (tire_footprint, both
-methods), ``seal`` (seal_leak: flat ring and Hertz O-ring), ``viscosity`` (pressure-dependent
-viscosity: Barus squeeze_out and tire_footprint, Barus and Roelands seals). :func:`scene_groups`
-infers the groups of a scene.
+methods), ``seal`` (seal_leak: flat ring and Hertz O-ring, and a study-sized O-ring call with
+an outlet pressure that reads the verified O-ring tables), ``viscosity`` (pressure-dependent
+viscosity: Barus squeeze_out and tire_footprint, Barus and Roelands seals, and study-sized
+O-ring calls of one oil per row and of one Roelands fluid: their table kernels). Each
+study-sized call builds its tables (a few seconds). :func:`scene_groups` infers the groups of
+a scene.
 """
 from __future__ import annotations
 
@@ -70,6 +73,25 @@ def _seal(T, **kw):
               E_star=_E_STAR, eta=_ETA, theory="critical_junction", **kw)
 
 
+def _seal_tables(T, **kw):
+    """Study-sized Hertz O-ring calls (scattered O-rings, and a Δp sweep of one), whose rows
+    are read from the verified O-ring tables (built here, a few seconds) instead of solved:
+    the table kernels a small call never reaches. ``kw``: the fluid (none: the base fluid
+    with an outlet pressure p_b > 0; else ``alpha_pv`` per row or a Roelands law)."""
+    import numpy as np
+    from .seal.api import seal_leak
+    n = 20000
+    rng = np.random.default_rng(0)
+    base = dict(profile="hertz", R=2e-3, L_y=0.1, E_star=_E_STAR, eta=_ETA,
+                theory="critical_junction")
+    for f_N, dp in ((rng.uniform(20.0, 200.0, n), rng.uniform(1e3, 5e4, n)),
+                    (100.0, np.linspace(1e3, 5e4, n))):
+        per_row = {k: (v(n) if callable(v) else v) for k, v in kw.items()}
+        if not kw:
+            per_row = {"p_b": 0.3 * dp}
+        seal_leak(T, f_N=f_N, dp=dp, **base, **per_row)
+
+
 def warm_group(group):
     """Run group ``group`` (a key of :data:`GROUPS`) in this process; returns its seconds."""
     if group not in GROUPS:
@@ -90,6 +112,7 @@ def warm_group(group):
             _tire(T, "emt", method)
     elif group == "seal":
         _seal(T)
+        _seal_tables(T)                      # p_b > 0
     else:
         import numpy as np
         from .squeeze import squeeze_out
@@ -103,6 +126,10 @@ def warm_group(group):
                 _tire(T, "emt", method, alpha_pv=alpha)
         _seal(T, alpha_pv=2e-7)
         _seal(T, viscosity="roelands", alpha_pv=2e-7, roelands_z=0.6, roelands_p_r=1.96e8)
+        # study-sized O-rings: one oil per row (Barus), one Roelands fluid
+        _seal_tables(T, alpha_pv=lambda n: np.linspace(1e-7, 3e-6, n))
+        _seal_tables(T, viscosity="roelands", alpha_pv=2e-7, roelands_z=0.6,
+                     roelands_p_r=1.96e8)
     return time.perf_counter() - t0
 
 

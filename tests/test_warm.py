@@ -101,6 +101,40 @@ def test_scene_groups_infer_tables_and_viscosity(tmp_path):
     assert scene_groups(load_scene(scene)) == ["tables", "squeeze"]
 
 
+def test_study_sized_seal_calls_reach_the_o_ring_tables(monkeypatch):
+    """The seal and viscosity groups' study-sized O-ring calls (``_seal_tables``) read their
+    rows from the verified tables (and so compile those kernels, which a few rows never
+    reach): p_b > 0, one Barus oil per row, one Roelands fluid's ψ_a from one ψ table."""
+    import numpy as np
+
+    from fastcontact import warm as warm_mod
+    from fastcontact.defaults import load_default_tables
+    from fastcontact.seal import hertz, viscosity
+
+    read = []
+
+    def spy(name, fn):
+        def wrapped(*args, **kwargs):
+            out = fn(*args, **kwargs)
+            read.append((name, out is not None and bool(np.isfinite(out).any())))
+            return out
+        return wrapped
+    monkeypatch.setattr(hertz, "table_W_pb", spy("pb", hertz.table_W_pb))
+    monkeypatch.setattr(hertz, "table_W_beta", spy("beta", hertz.table_W_beta))
+    monkeypatch.setattr(viscosity, "psi_drops_one_law",
+                        spy("psi", viscosity.psi_drops_one_law))
+    T = load_default_tables("asphalt_024mm")
+    warm_mod._seal_tables(T)
+    assert ("pb", True) in read
+    read.clear()
+    warm_mod._seal_tables(T, alpha_pv=lambda n: np.linspace(1e-7, 3e-6, n))
+    assert ("beta", True) in read
+    read.clear()
+    warm_mod._seal_tables(T, viscosity="roelands", alpha_pv=2e-7, roelands_z=0.6,
+                          roelands_p_r=1.96e8)
+    assert any(name == "psi" for name, _ in read)
+
+
 def test_bad_input_names_the_parameter(capsys):
     assert main(["compile", "tyre"]) == 2
     err = capsys.readouterr().err
