@@ -53,6 +53,8 @@ SURFACE = "asphalt_024mm"
 E, ETA, R = 13e6, 1e-3, 0.02
 #: the columns of a study that only asks whether the film has drained at the footprint exit
 EXIT_COLUMNS = ("u_exit", "du_exit", "squeeze_complete", "status")
+#: footprint pressures [Pa] of the "tire, tire pressures" row (log-uniform): 0.02–1 MPa
+TIRE_P0 = (2e4, 1e6)
 REF_P0 = {"average": [2e3, 0.2e6], "critical_junction": [0.2e6], "emt": [0.2e6]}
 
 
@@ -180,6 +182,12 @@ def speeds(T, th, n_fast, n_quad, repeats):
                 T, p0=p0, E_star=E, R=Rr, eta=ETA, theory=th, footprint_length=fl, speed=sp,
                 method=method, columns=list(EXIT_COLUMNS)),
         }
+        # a tire study's own pressures (TIRE_P0: footprint pressures of car and truck tires)
+        p0t = np.exp(rng.uniform(math.log(max(lo, TIRE_P0[0])), math.log(min(top, TIRE_P0[1])),
+                                 n))
+        jobs["tire, tire pressures"] = lambda: tire_footprint(
+            T, p0=p0t, E_star=E, R=Rr, eta=ETA, theory=th, footprint_length=fl, speed=sp,
+            method=method)
         for name, job in jobs.items():
             res[(name, method)] = n / timed(job, repeats)
         t = np.geomspace(1e-7, 1e2, n)
@@ -243,11 +251,11 @@ def write(rows, t_ref, load0, load1, n_fast, n_quad):
          "| theory | path | fast: cases/s | fast: max rel. err | quad: cases/s | quad: max rel. err | fast / quad speed |",
          "|---|---|---|---|---|---|---|"]
     emap = {"default start": "default", "given start": "given", "times": "times", "tire": "tire",
-            "tire, exit columns": "tire_exit", "history": "times",
+            "tire, exit columns": "tire_exit", "history": "times", "tire, tire pressures": "tire",
             "given start, Δu, one time": "given_du_time"}
     for th, r in rows.items():
         for path in ("default start", "given start", "times", "given start, Δu, one time",
-                     "tire", "tire, exit columns", "history"):
+                     "tire", "tire, exit columns", "tire, tire pressures", "history"):
             f, q = r["speed"][(path, "fast")], r["speed"][(path, "quad")]
             L.append(f"| {th} | {path} | {f:.3g} | {r['err_fast'][emap[path]]:.1e} | {q:.3g} | "
                      f"{r['err_quad'][emap[path]]:.1e} | {f / q:.3g} |")
@@ -259,7 +267,11 @@ def write(rows, t_ref, load0, load1, n_fast, n_quad):
           "the worse of t to ū∞ + 0.01 ū∞ (a Δu target) and ū - ū∞ at a time, in one call "
           "(its speed: a Δu target of 1 µm and ū at 1 ms per case). \"tire, exit columns\": "
           f"`tire_footprint(columns={list(EXIT_COLUMNS)})`, which computes only ū at the exit "
-          "(no ratio or Δu targets), its error measured on that call. History cases/s are "
+          "(no ratio or Δu targets), its error measured on that call. \"tire, tire "
+          f"pressures\": the tire call with p0 log-uniform in {TIRE_P0[0]:.0e}–{TIRE_P0[1]:.0e} Pa "
+          "(the footprint pressures of a tire study; the rows above span the whole table, where "
+          "at low p0 the film has not drained at the exit and ū there costs a second "
+          "inversion), its error the tire row's (same engine and reference cases). History cases/s are "
           "(case × time) "
           "points/s; its quad baseline is `squeeze_out(method='quad', times=...)`.", "",
           "First call on newly loaded tables (kernels compiled; builds the time primitive), "

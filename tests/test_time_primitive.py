@@ -244,6 +244,38 @@ def test_inverse_round_trip_every_branch(T, theory):
     assert hit == {"tail", "grid", "below", "far below"}
 
 
+@pytest.mark.parametrize("theory", ["critical_junction", "emt"])
+def test_hinted_inverse_is_the_bisected_one_bit_for_bit(T, theory):
+    """z_of_t_from (the grid cell searched from a hint's cell: ū at an exit time after a first
+    inversion, the next time of a history) returns z_of_t_at's z exactly, for hints in the
+    root's cell, a few cells off (walked), far off, outside the grid and NaN (bisected), and
+    for T in every branch (tail and below the grid: no search)."""
+    from fastcontact.squeeze._primitive_eval import inverse_constants, z_of_t_at, z_of_t_from
+
+    pr = squeeze_model(T, theory).primitive()
+    pr = pr if hasattr(pr, "xn") else pr[0]
+    rng = np.random.default_rng(12)
+    x_hi = min(pr.xn[-1], prim.fast_limit(squeeze_model(T, theory)))
+    offsets = np.array([0.0, 0.3, -0.3, 1.0, -1.0, 2.5, -2.5, 3.0, -3.0, 7.0, -7.0, 60.0, -60.0])
+    walked = bisected = 0
+    for x0 in rng.uniform(pr.xn[0], x_hi, 30):
+        st = prim.stencil(pr, x0)
+        vinf = math.exp(prim.row_value(pr.lnv, st))
+        lk = prim.row_value(pr.lk, st)
+        ic = inverse_constants(pr, st)
+        z_ext = math.log(pr.v_ext / vinf - 1.0)
+        for z in np.concatenate([rng.uniform(pr.z0 - lk, min(z_ext, pr.z0 - lk + (pr.nz - 1) * pr.dz), 12),
+                                 [pr.z0 - lk - 3.0, z_ext + 0.5]]):
+            t = prim.t_of_z(pr, st, vinf, z)
+            ref = z_of_t_at(pr, st, vinf, t, ic)
+            for hint in np.concatenate([ref + offsets * pr.dz, [math.nan, math.inf, -math.inf]]):
+                got = z_of_t_from(pr, st, vinf, t, ic, hint)
+                assert got == ref, (x0, z, hint, got, ref)
+                walked += abs(hint - ref) <= 3.0 * pr.dz
+                bisected += not abs(hint - ref) <= 3.0 * pr.dz
+    assert walked > 1000 and bisected > 500
+
+
 def test_bad_rows_do_not_sink_the_batch(T):
     lo, hi = T.p_range
     p0 = np.array([1e5, 0.5 * lo * E, 1e5, 2 * hi * E, 1e5])

@@ -14,7 +14,8 @@ import numpy as np
 from numba import njit, prange
 
 from . import _kernels as qk
-from ._primitive_eval import inverse_constants, inverse_constants_ext, tail_top, z_of_t_at
+from ._primitive_eval import (inverse_constants, inverse_constants_ext, tail_top, z_of_t_at,
+                              z_of_t_from)
 from .primitive import Primitive, first_row, row_value, stencil, t_of_z
 from ._primitive_eval import lagrange_denominators, one_plus_exp, t_of_zv
 from ..kernels.borrow import borrowed
@@ -233,7 +234,11 @@ def _u_at(pr, st, vinf, vs, zs, Ts, Ts_row, tt, h, ic):
         if z < zs - GUARD_Z:
             return vinf * one_plus_exp(z) * h, Ts
         Ts = t_of_zv(pr, st, vinf, zs, vs)
-    z = z_of_t_at(pr, st, vinf, Ts + tt, ic)
+        # Ts and Ts_row differ by the row table's interpolation error: the root is in or
+        # next to the first one's cell
+        z = z_of_t_from(pr, st, vinf, Ts + tt, ic, z)
+    else:
+        z = z_of_t_at(pr, st, vinf, Ts + tt, ic)
     # ū(t) <= ū(0): the inverse can land an ulp above the start for t → 0; keeps the ODE's
     # monotonicity (a round-off bound, not a clamp)
     return min(vinf * one_plus_exp(z), vs) * h, Ts
@@ -486,6 +491,7 @@ def history_kernel(pr, st, vs_in, tau, h, t, u):
 def _history_block(pr, st, vinf, vs, Ts, ic, tau, h, t, u, k0, k1):
     """Times k0 <= k < k1 of :func:`history_kernel` (the primitive borrowed)."""
     pr = borrowed(pr)
+    z = math.nan  # the previous time's root: the search of the next starts from its cell
     for k in range(k0, k1):
         tk = qk.reduced_time(t[k], tau)
         if tk == 0.0:
@@ -493,4 +499,5 @@ def _history_block(pr, st, vinf, vs, Ts, ic, tau, h, t, u, k0, k1):
         elif tk == math.inf:
             u[k] = vinf * h
         else:
-            u[k] = min(vinf * one_plus_exp(z_of_t_at(pr, st, vinf, Ts + tk, ic)), vs) * h
+            z = z_of_t_from(pr, st, vinf, Ts + tk, ic, z)
+            u[k] = min(vinf * one_plus_exp(z), vs) * h

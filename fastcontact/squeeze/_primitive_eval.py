@@ -18,7 +18,7 @@ from ..kernels.hermite import quintic_unit
 from . import _kernels as qk
 
 __all__ = ["Primitive", "first_row", "stencil", "row_value", "row_value_2", "t_of_z", "t_of_zv",
-           "z_of_t", "z_of_t_at", "inverse_constants", "inverse_constants_ext", "tail_top",
+           "z_of_t", "z_of_t_at", "z_of_t_from", "inverse_constants", "inverse_constants_ext", "tail_top",
            "lagrange_denominators", "one_plus_exp", "Z_NEGLIGIBLE"]
 
 #: the tabulated primitive (reduced units). xn (nx) x0 nodes and their locator (blo, bdz,
@@ -289,6 +289,47 @@ def z_of_t_at(pr, st, vinf, T, ic):
     cf = _cell(pr, st, lo)
     t = _halley_cell(cf, pr.dz, lt, _inverse_guess(cf, pr.dz, y_lo, y_hi, lt))
     return pr.z0 + (lo + t) * pr.dz - lk
+
+
+#: cells :func:`z_of_t_from` walks from its hint's cell before it bisects instead
+HINT_WALK = 3
+
+
+@njit(cache=True, inline="always")
+def z_of_t_from(pr, st, vinf, T, ic, z_hint):
+    """:func:`z_of_t_at`, the grid cell searched from the cell of ``z_hint`` (a z near the
+    root: an earlier root of a nearby T) instead of bisected over the whole grid: at most
+    HINT_WALK cells either way, else the bisection. The cell is the same unique cell with
+    ln T(k) >= ln T > ln T(k+1) that the bisection finds and the same Halley iteration
+    follows, so the result is :func:`z_of_t_at`'s bit for bit; only the search is shorter."""
+    T_ext, lk, T0, _h0, _S = ic
+    if not (T_ext < T < T0) or not (abs(z_hint) < 1e300):
+        return z_of_t_at(pr, st, vinf, T, ic)
+    lt = math.log(T)
+    k = int((z_hint + lk - pr.z0) / pr.dz)
+    top = pr.nz - 2
+    if k < 0:
+        k = 0
+    elif k > top:
+        k = top
+    y_lo = row_value_2(pr.C, st, k)
+    y_hi = row_value_2(pr.C, st, k + 1)
+    for _ in range(HINT_WALK):
+        if y_lo < lt and k > 0:
+            k -= 1
+            y_hi = y_lo
+            y_lo = row_value_2(pr.C, st, k)
+        elif y_hi >= lt and k < top:
+            k += 1
+            y_lo = y_hi
+            y_hi = row_value_2(pr.C, st, k + 1)
+        else:
+            break
+    if not (y_lo >= lt > y_hi):
+        return z_of_t_at(pr, st, vinf, T, ic)
+    cf = _cell(pr, st, k)
+    t = _halley_cell(cf, pr.dz, lt, _inverse_guess(cf, pr.dz, y_lo, y_hi, lt))
+    return pr.z0 + (k + t) * pr.dz - lk
 
 
 @njit(cache=True, inline="always")
