@@ -225,16 +225,22 @@ def hertz_pb_lines(p):
         f"nodes and {p['cells']:,} cells verified ({p['failed']:,} failed: solver), "
         f"{p['solves']:,} solves at the table tolerance.",
         "",
+        *_table_rows(n, p, "`solver=dict(table=False)`"),
+        "",
+    ]
+
+
+def _table_rows(n, p, solver):
+    """The Markdown table of a kept-table section: its header, the steady-state and
+    first-call rows and the per-row solver's (``solver``: how it was forced)."""
+    return [
         "| path | end-to-end rows/s | × solver | max rel. error of Q vs solver |",
         "|---|---|---|---|",
         f"| table (steady state, table kept) | {n / p['t_table']:.3g} | "
         f"{p['t_solver'] / p['t_table']:.3g} | {p['err']:.1e} |",
         f"| table, first call (builds it: lines + verification) | {n / p['t_first']:.3g} | "
         f"{p['t_solver'] / p['t_first']:.3g} | same rows |",
-        f"| per-row solver (`solver=dict(table=False)`, prange) | {n / p['t_solver']:.3g} | 1 | "
-        f"– |",
-        "",
-    ]
+        f"| per-row solver ({solver}, prange) | {n / p['t_solver']:.3g} | 1 | – |"]
 
 
 #: Barus O-rings, one oil per row: as PB_N/PB_PH, p_b = 0, α p_H log-uniform in OIL_B
@@ -301,13 +307,7 @@ def oils_lines(p):
         f"{fastcontact.seal.hertz.NY + 1} nodes and {p['cells']:,} cells verified "
         f"({p['failed']:,} failed: solver), {p['solves']:,} solves at the table tolerance.",
         "",
-        "| path | end-to-end rows/s | × solver | max rel. error of Q vs solver |",
-        "|---|---|---|---|",
-        f"| table (steady state, table kept) | {n / p['t_table']:.3g} | "
-        f"{p['t_solver'] / p['t_table']:.3g} | {p['err']:.1e} |",
-        f"| table, first call (builds it: lines + verification) | {n / p['t_first']:.3g} | "
-        f"{p['t_solver'] / p['t_first']:.3g} | same rows |",
-        f"| per-row solver (`TABLE_MIN_ROWS` raised, prange) | {n / p['t_solver']:.3g} | 1 | – |",
+        *_table_rows(n, p, "`TABLE_MIN_ROWS` raised"),
         f"| base fluid (α = 0) on the same O-rings, its table | {n / p['base']:.3g} | "
         f"{p['t_solver'] / p['base']:.3g} | – |",
         "",

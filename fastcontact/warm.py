@@ -86,10 +86,8 @@ def _seal_tables(T, **kw):
                 theory="critical_junction")
     for f_N, dp in ((rng.uniform(20.0, 200.0, n), rng.uniform(1e3, 5e4, n)),
                     (100.0, np.linspace(1e3, 5e4, n))):
-        per_row = {k: (v(n) if callable(v) else v) for k, v in kw.items()}
-        if not kw:
-            per_row = {"p_b": 0.3 * dp}
-        seal_leak(T, f_N=f_N, dp=dp, **base, **per_row)
+        fluid = {k: (v(n) if callable(v) else v) for k, v in kw.items()} or {"p_b": 0.3 * dp}
+        seal_leak(T, f_N=f_N, dp=dp, **base, **fluid)
 
 
 def warm_group(group):

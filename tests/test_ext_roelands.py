@@ -225,7 +225,7 @@ def test_one_law_drops_share_one_table_against_quad():
     (``psi_drops_one_law``, the O-ring tables' ψ_a), against scipy quad of the law written out,
     from drops 1e-6 of the largest to the largest: within 1e-11; where that one table would
     need more than PSI_MAX_NODES nodes (a steep law over a large drop) ``one_table_fits`` says
-    no and each row keeps its own table (``psi_drops``)."""
+    no and each row keeps its own table (``psi_drops``'s values exactly)."""
     from scipy.integrate import quad
 
     from fastcontact.seal._roelands_psi import (PSI_MAX_NODES, one_table_fits, psi_drops,
@@ -252,6 +252,9 @@ def test_one_law_drops_share_one_table_against_quad():
     dpi = np.array([1e6, 1e8]) / E
     own = np.empty(2)
     psi_drops(np.full(2, A), np.full(2, 0.68), np.full(2, 1e5 / E), dpi, own)
+    shared = np.empty(2)
+    psi_drops_one_law(A, 0.68, 1e5 / E, dpi, shared)   # falls back to each row's own table
+    np.testing.assert_array_equal(shared, own)
     law = roelands(0.5, 0.68, 1e-5)
     ref = quad(lambda x: 1.0 / law(x), 0.0, 1e6, epsabs=0.0, epsrel=1e-13, limit=200)[0] / E
     assert abs(own[0] / ref - 1) < 1e-11

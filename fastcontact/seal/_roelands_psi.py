@@ -182,10 +182,15 @@ def _read_one_table(A, Z, pr, h, y, g, s, dpi, out):
 @njit(cache=True)
 def psi_drops_one_law(A, Z, pr, dpi, out):
     """ψ(Δπ) of rows sharing one law (A, Z, π_r; scalars, reduced) into ``out``: one table
-    reaching the largest drop (node width no larger than each row's own table's bound, where
-    :func:`one_table_fits`; the same quintic Hermite), read in parallel."""
+    reaching the largest drop (node width no larger than each row's own table's bound; the
+    same quintic Hermite), read in parallel, where :func:`one_table_fits`; else each row's
+    own table (:func:`psi_drops`)."""
     top = 0.0
     for i in range(dpi.size):
         top = max(top, dpi[i])
+    if not one_table_fits(A, Z, pr, top):
+        for i in range(dpi.size):
+            out[i] = psi_of(psi_table(A, Z, pr, dpi[i]), dpi[i])
+        return
     rt = psi_table(A, Z, pr, top)
     _read_one_table(rt.A, rt.Z, rt.pr, rt.h, rt.y, rt.g, rt.s, dpi, out)

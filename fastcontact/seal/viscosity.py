@@ -65,7 +65,7 @@ from .context import (NEAR_LIFT_OFF, new_runs, peak_past_trust, seal_context,
                       solve_profile_rows, solver_options)
 from ._piezo_kernels import (TAIL_CUT, HertzRows, Quad, RingCells, UniformRows, _cells_kernel,
                              _cells_rows, _hertz_kernel, _hertz_kernel_r, _uniform_sweep_kernel)
-from ._roelands_psi import one_table_fits, psi_drops, psi_drops_one_law
+from ._roelands_psi import psi_drops, psi_drops_one_law
 
 __all__ = ["HERTZ_STEPS", "TAIL_CUT", "seal_leak_piezo"]
 
@@ -739,16 +739,10 @@ def _roelands_hertz_k_tabled(tables, theory, E, pH, a, pa, pb, A, Z, pr):
     def one_fluid(key, i):
         sub = [x[i] for x in args]
 
-        law = tuple(float(x) for x in key)  # (A, Z, π_r), one per fluid
-
-        def psia(j):  # E* ψ_a [Pa] from the law's tabulated ψ
+        def psia(j):  # E* ψ_a [Pa] from the law's tabulated ψ (one table for its rows)
             out = np.empty(j.size)
-            dpi = np.ascontiguousarray((sub[3][j] - sub[4][j]) / sub[0][j], dtype=np.float64)
-            if dpi.size and one_table_fits(*law, float(dpi.max())):
-                psi_drops_one_law(*law, dpi, out)  # one table for the fluid's rows
-            else:
-                psi_drops(*(np.ascontiguousarray(x[j], dtype=np.float64) for x in
-                            (sub[5], sub[6], prn[i])), dpi, out)
+            psi_drops_one_law(*(float(x) for x in key), np.ascontiguousarray(
+                (sub[3][j] - sub[4][j]) / sub[0][j], dtype=np.float64), out)
             return sub[0][j] * out
         return _hertz_k_tabled(tables, theory, *sub[:5], 0.0, key, psia,
                                lambda j: _roelands_hertz_k(tables, theory, *(x[j] for x in sub)))
