@@ -349,3 +349,38 @@ def test_worker_preload_drops_only_the_lost_heartbeat():
     assert r.stdout.strip() == "True"
     assert "heartbeat" not in r.stderr
     assert "Compute Failed" in r.stderr and "OSError: Stream is closed" in r.stderr
+
+
+def test_held_interrupt_waits_for_the_dask_call_then_raises_once():
+    """A signal during a held Dask call (``Future.result``) raises when the call has
+    returned, not inside distributed's wait (where its cancel callback can fail with a
+    traceback); a second signal while held raises at once; outside a hold, at once."""
+    import threading
+    from distributed import Client
+    from fastcontact.studies.sweep_control import (SweepInterrupted, _held_interrupts,
+                                                   _interrupts)
+
+    def later(sig, seconds):
+        threading.Timer(seconds, os.kill, (os.getpid(), sig)).start()
+
+    got = []
+    with Client(processes=False, n_workers=1, threads_per_worker=1,
+                dashboard_address=None) as client, _interrupts():
+        fut = client.submit(time.sleep, 1.0, pure=False)
+        later(signal.SIGINT, 0.2)
+        with pytest.raises(SweepInterrupted) as exc:
+            with _held_interrupts():
+                fut.result()
+                got.append(fut.status)
+        assert got == ["finished"] and exc.value.exit_code == 130
+        with pytest.raises(SweepInterrupted) as exc:      # a second signal: at once
+            with _held_interrupts():
+                later(signal.SIGTERM, 0.0)
+                later(signal.SIGTERM, 0.3)
+                time.sleep(5.0)
+                got.append("slept")
+        assert got == ["finished"] and exc.value.exit_code == 143
+        with pytest.raises(SweepInterrupted):                # not held: at once
+            later(signal.SIGINT, 0.0)
+            time.sleep(5.0)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

@@ -41,7 +41,8 @@ from .load import load_scene
 from .output import write_json_atomic, write_parquet_atomic
 from .scene import Scene, SurfaceSpec
 from .sweep_control import (LOCK_NAME, LOCK_STALE_SECONDS, SweepError, SweepInterrupted,
-                            _ignore_signals, _interrupts, _Lock, _utc_now)
+                            _held_interrupts, _ignore_signals, _interrupts, _Lock,
+                            _utc_now)
 
 __all__ = ["run_sweep", "read_sweep", "sweep_key", "worker_environment", "local_cluster",
            "SweepError", "SweepInterrupted", "LOCK_NAME", "LOCK_STALE_SECONDS"]
@@ -251,7 +252,8 @@ def _compute(todo, spectra, sc, outdir, key, cache_dir, client, manifest, done, 
     for fut in as_completed(list(futs)):
         sid = futs[fut]
         try:
-            done[sid] = fut.result()
+            with _held_interrupts():
+                done[sid] = fut.result()
         except Exception as exc:  # noqa: BLE001 - a task crashed: record, go on
             manifest["failed"][sid] = f"{type(exc).__name__}: {exc}"
         bar.update(1)
@@ -351,11 +353,12 @@ def _run_locked(db, outdir, sc, ids, spectra, fingerprint, key, scheduler, worke
     try:
         if todo:
             from distributed import Client
-            if scheduler:
-                client, info = Client(scheduler, timeout="30s"), {"scheduler": scheduler}
-            else:
-                cluster, info = local_cluster(workers)
-                client = Client(cluster)
+            with _held_interrupts():
+                if scheduler:
+                    client, info = Client(scheduler, timeout="30s"), {"scheduler": scheduler}
+                else:
+                    cluster, info = local_cluster(workers)
+                    client = Client(cluster)
             manifest["cluster"] = info
             _compute(todo, spectra, sc, outdir, key, cache_dir, client, manifest, done, bar,
                      mpath)

@@ -151,14 +151,48 @@ def _signal_handlers(handler):
             signal.signal(s, h)
 
 
+class _Held:
+    """State of :func:`_held_interrupts` (main thread only: signal handlers run there)."""
+    depth = 0
+    pending = None
+
+
+def _interrupted(signum):
+    return SweepInterrupted(signal.Signals(signum).name, _EXIT_CODES[signum])
+
+
 def _raise_interrupted(signum, frame):
-    """Signal handler: raise :class:`SweepInterrupted` named for the signal."""
-    name = signal.Signals(signum).name
-    raise SweepInterrupted(name, _EXIT_CODES[signum])
+    """Signal handler: raise :class:`SweepInterrupted` named for the signal — at once, or,
+    inside :func:`_held_interrupts`, when that ends (a second signal there raises at once)."""
+    if _Held.depth > 0 and _Held.pending is None:
+        _Held.pending = signum
+        return
+    _Held.pending = None
+    raise _interrupted(signum)
+
+
+@contextlib.contextmanager
+def _held_interrupts():
+    """Hold a SIGINT / SIGTERM until the block ends, then raise it.
+
+    For the driver's blocking Dask calls (``Future.result``, starting the client):
+    ``distributed.utils.sync`` answers a KeyboardInterrupt raised inside its wait by
+    scheduling a ``cancel`` callback that can run before its coroutine has created the
+    future it cancels, and tornado then prints that callback's ``NameError`` traceback
+    (distributed 2026.8). Raised here, between Dask calls, the interrupt stays one line."""
+    _Held.depth += 1
+    try:
+        yield
+    finally:
+        _Held.depth -= 1
+        if _Held.depth == 0 and _Held.pending is not None:
+            signum, _Held.pending = _Held.pending, None
+            raise _interrupted(signum)
 
 
 def _interrupts():
     """SIGINT / SIGTERM raise :class:`SweepInterrupted` in the main thread while inside."""
+    _Held.depth, _Held.pending = 0, None
     return _signal_handlers(_raise_interrupted)
 
 
