@@ -59,12 +59,6 @@ def new_status(n):
     return np.full(n, NOT_COMPUTED, dtype=np.int8)
 
 
-def trapped_mask(status, u_trap):
-    """The ``trapped`` column: fluid trapped by the physics (ū_trap set), also on rows whose
-    status says "overflow" (τ0 or a time not representable)."""
-    return (status == ST_TRAPPED) | ((status == ST_OVERFLOW) & np.isfinite(u_trap))
-
-
 @njit(cache=True)
 def tail_sigma(mp, v):
     """(σ̄, d ln σ̄/d ln v) of the analytic tail above the table top at v > v_top [h_rms]:

@@ -18,6 +18,7 @@ from . import _kernels as qk
 from ._fastpath import fast_kernel, history_kernel, one_case_primitive, quad_kernel, row_targets
 from .model import DEFAULT_P_START, squeeze_model
 from .primitive import fast_limit
+from ._columns import status_flags
 from .reduced import flat_separation
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.readonly import readonly_fields
@@ -287,10 +288,7 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=No
 def frame(model, cs, out, ratios, du, times, order, names, method):
     """The result DataFrame of :func:`squeeze_out` from the kernel outputs."""
     status = out.status
-    trapped = qk.trapped_mask(status, out.u_trap)
-    x_perc = model.x_perc
-    perc = (trapped & (np.log(cs.p0 / cs.E) >= x_perc) if np.isfinite(x_perc)
-            else np.zeros(status.size, dtype=bool))
+    trapped, perc, oot = status_flags(status, out.u_trap, cs.p0, cs.E, model.x_perc)
     cols = {"p0": cs.p0, "E_star": cs.E, "R": cs.R, "eta": cs.eta, "u_start": out.u_start,
             "u_inf": out.u_inf, "t_star": out.T[0]}
     k = 1
@@ -303,7 +301,7 @@ def frame(model, cs, out, ratios, du, times, order, names, method):
         cols[name] = out.U[inv[j]]
     cols.update({"tau0": out.tau0, "t_relax": out.t_relax, "trapped": trapped,
                  "percolated": perc, "u_trap": out.u_trap, "t_trap": out.t_trap,
-                 "fluid_load_fraction": out.flf, "out_of_table": status == qk.ST_OUT,
+                 "fluid_load_fraction": out.flf, "out_of_table": oot,
                  "status": status_column(status)})
     df = pd.DataFrame(cols, copy=False)
     df.attrs.update(attrs(model, names, method))

@@ -51,7 +51,7 @@ from .api import _check_method, attrs, run_cases, squeeze_history, squeeze_out, 
 from .model import squeeze_model
 from .primitive import fast_limit
 from ._fastpath import history_kernel, one_case_primitive
-from .reduced import inertia_tau
+from ._columns import exit_columns, inertia_columns, status_flags
 
 __all__ = ["tire_footprint", "tire_history", "tire_columns", "profile_factors",
            "pressure_profile", "squeeze_method", "PAPER_TIRE"]
@@ -188,16 +188,14 @@ def _squeeze_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
     sq = run_cases(model, cs, r, np.array([du_complete / model.h_rms] if du else []),
                    np.ascontiguousarray(t_fp[None, :]) if exit_ else np.zeros((0, 1)), method,
                    quad, timescales=False)
-    out.update(u_inf=sq.u_inf, u_start=sq.u_start, t_star=sq.T[0],
-               trapped=qk.trapped_mask(sq.status, sq.u_trap), u_trap=sq.u_trap,
-               fluid_load_fraction=sq.flf, out_of_table=sq.status == qk.ST_OUT,
+    trapped, _, oot = status_flags(sq.status, sq.u_trap)
+    out.update(u_inf=sq.u_inf, u_start=sq.u_start, t_star=sq.T[0], trapped=trapped,
+               u_trap=sq.u_trap, fluid_load_fraction=sq.flf, out_of_table=oot,
                status=status_column(sq.status))
     if du:
         out["t_du"] = sq.T[1 + r.size]
     if exit_:
-        du_exit = sq.U[0] - sq.u_inf
-        with np.errstate(invalid="ignore"):
-            complete = du_exit <= du_complete
+        du_exit, complete = exit_columns(sq.U[0], sq.u_inf, du_complete)
         out.update(u_exit=sq.U[0], du_exit=du_exit, squeeze_complete=complete)
     for j, k in enumerate(keep):
         out[names[k]] = sq.T[1 + j]
@@ -240,20 +238,10 @@ def _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, metho
 
 def _inertia_columns(b, p_eval, u_used, h_rms, out):
     """``tau_inertia`` τ' = (D²ρ/(64 p_eval))^{1/2} [s] (D = 2R) and ``t_star_inertia``
-    τ' ln(ū(0)/h_rms) [s] (NaN where ū(0) is unknown or <= h_rms) into ``out`` — Sec. 5."""
-    with np.errstate(over="ignore"):  # R ~ 1e308 m: τ' = inf on a row flagged "overflow"
-        tau = inertia_tau(2.0 * b["R"], b["rho"], p_eval)  # inputs validated: n values
-    out["tau_inertia"] = tau
-    if u_used is None:
-        out["t_star_inertia"] = np.full(p_eval.size, np.nan)
-        return
-    t = np.empty(p_eval.size)  # in place from here: one array per million cases
-    with np.errstate(invalid="ignore", divide="ignore"):
-        np.divide(u_used, h_rms, out=t)  # ū(0) one per case or one for all
-        np.log(t, out=t)
-        t *= tau
-    t[~np.broadcast_to(np.asarray(u_used) > h_rms, t.shape)] = np.nan
-    out["t_star_inertia"] = t
+    τ' ln(ū(0)/h_rms) [s] (NaN where ū(0) is unknown or <= h_rms) into ``out`` — Sec. 5
+    (one parallel pass; R ~ 1e308 m gives τ' = inf on a row flagged "overflow")."""
+    out["tau_inertia"], out["t_star_inertia"] = inertia_columns(b["R"], b["rho"], p_eval,
+                                                                u_used, h_rms)
 
 
 def _footprint_frame(out, columns, n, model, method):
@@ -354,7 +342,8 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
             method = squeeze_method(n)
         model = _viscous_columns(tables, b, p_eval, t_fp, theory, ratios, du_complete, method,
                                  out, want)
-        u_used = out["u_start"]
+        if u_used is None:  # the default start: each row's own
+            u_used = out["u_start"]
     if want & {"tau_inertia", "t_star_inertia"}:
         _inertia_columns(b, p_eval, u_used, tables.h_rms, out)
     return _footprint_frame(out, columns, n, model, method)
