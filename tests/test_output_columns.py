@@ -63,3 +63,58 @@ def test_inertia_columns_are_sec5_formulas(shared):
     # the paper's example (Sec. 5): D = 2 cm, ρ = 1000 kg/m³, p0 = 0.3 MPa → τ' = 1.4434e-4 s
     one, none = inertia_columns(np.array(0.01), np.array(1000.0), np.array([3e5]), None, h)
     assert one[0] == pytest.approx(1.4434e-4, rel=1e-4) and np.isnan(none).all()
+
+
+def test_history_columns_are_the_model_and_stefan_law():
+    """p_cont/p0 from the model's π_c(v) (the record-passing kernel ``model.p_of_v``,
+    tables and the eq. (3) tail above their top), p̄_f = p0 (1 − p_cont/p0), and the
+    flat-substrate Stefan law of ``reduced.flat_separation`` (0 at t = inf) — bit for bit,
+    for times in order (the blocks' interval hint) and shuffled (hint misses)."""
+    from fastcontact.squeeze import squeeze_model
+    from fastcontact.squeeze._columns import history_columns
+    from fastcontact.squeeze.reduced import flat_separation
+    from fastcontact.tables import Tables
+    from fastcontact.tables.defaults import default_table_path
+    T = Tables.from_parquet(default_table_path("asphalt_024mm"))
+    model = squeeze_model(T, "emt")
+    h = model.h_rms
+    p0, E, eta, R, us = 2e5, 13e6, 1e-3, 0.02, 3e-3
+    v = np.geomspace(model.mp.v_top * 3.0, 0.5 * math.exp(model.tab.lnu[-1]), 20_000)
+    # ^ the tail, the table, below its lowest separation (NaN)
+    u = v * h
+    t = np.concatenate([[0.0], np.geomspace(1e-8, 1e3, v.size - 2), [np.inf]])
+    for order in (np.arange(v.size), RNG.permutation(v.size)):
+        ratio, pf, flat = history_columns(model, u[order], t[order], p0, E, eta, R, us)
+        want = model.p_of_v(u[order] / h) / (p0 / E)
+        assert np.array_equal(ratio, want, equal_nan=True)
+        assert np.isnan(ratio).any() and (np.log(v[order][np.isnan(ratio)]) < model.tab.lnu[-1]).all()
+        assert np.array_equal(pf, p0 * (1.0 - want), equal_nan=True)
+        fin = np.isfinite(t[order])
+        f_want = np.where(fin, flat_separation(us, np.where(fin, t[order], 0.0), p0, eta, R), 0.0)
+        assert np.array_equal(flat, f_want)
+    assert (v > model.mp.v_top).any()
+
+
+def test_hinted_locate_is_locate():
+    """locate_desc_from returns locate_desc's interval whatever the hint (right, off by
+    one or more, outside the table), also at the nodes themselves."""
+    from numba import njit
+
+    from fastcontact.kernels.locate import build_bucket_map, locate_desc, locate_desc_from
+
+    @njit
+    def both(ys, yd, lo, dz, idx, hints, a, b):
+        for k in range(ys.size):
+            a[k] = locate_desc(ys[k], yd, lo, dz, idx)
+            b[k] = locate_desc_from(ys[k], yd, lo, dz, idx, hints[k])
+
+    yd = np.sort(RNG.uniform(-5.0, 3.0, 150))[::-1].copy()
+    lo, dz, idx = build_bucket_map(yd)
+    ys = np.concatenate([RNG.uniform(-6.0, 4.0, 20_000), yd, [yd[0], yd[-1]]])
+    a = np.empty(ys.size, dtype=np.int64)
+    b = np.empty_like(a)
+    for hints in (np.full(ys.size, -1), RNG.integers(-2, yd.size + 2, ys.size)):
+        both(ys, yd, lo, dz, idx, hints, a, b)
+        assert np.array_equal(a, b)
+    both(ys, yd, lo, dz, idx, np.maximum(a, 0), a, b)  # each its own interval as hint
+    assert np.array_equal(a, b) and (a == -1).any()

@@ -21,7 +21,7 @@ from numba import njit
 from ._index import clamp_index
 from .hermite import quintic_interval  # noqa: F401  (re-export, old home)
 
-__all__ = ["Grid", "quintic_interval", "build_bucket_map", "locate_desc",
+__all__ = ["Grid", "quintic_interval", "build_bucket_map", "locate_desc", "locate_desc_from",
            "locate_asc"]
 
 LN10 = math.log(10.0)
@@ -87,6 +87,16 @@ def locate_desc(y, y_desc, b_lo, b_dz, b_idx):
     while i < n - 2 and y_desc[i + 1] > y:
         i += 1
     return i
+
+
+@njit(cache=True, inline="always")
+def locate_desc_from(y, y_desc, b_lo, b_dz, b_idx, hint):
+    """:func:`locate_desc`, first trying the interval ``hint`` (an earlier result, for a
+    nearby y): taken where y_desc[hint] > y >= y_desc[hint+1], the one interval whose upper
+    node lies strictly above y — the interval locate_desc's walk stops at — else located."""
+    if 0 <= hint < y_desc.size - 1 and y_desc[hint] > y >= y_desc[hint + 1]:
+        return hint
+    return locate_desc(y, y_desc, b_lo, b_dz, b_idx)
 
 
 @njit(cache=True)

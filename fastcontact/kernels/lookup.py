@@ -20,8 +20,8 @@ from numba import njit
 from .hermite import quintic_interval
 from .locate import locate_asc, locate_desc
 
-__all__ = ["TableKernel", "k_lnu_of_lnp", "k_lnp_of_lnu", "k_sigma_of_lnp", "k_state_of_lnu",
-           "eval_u", "eval_p", "eval_sigma"]
+__all__ = ["TableKernel", "k_lnu_of_lnp", "k_lnp_of_lnu", "lnp_on_interval", "k_sigma_of_lnp",
+           "k_state_of_lnu", "eval_u", "eval_p", "eval_sigma"]
 
 
 class TableKernel(NamedTuple):
@@ -87,7 +87,15 @@ def k_lnp_of_lnu(tab, lnu_q):
     i = locate_desc(lnu_q, tab.lnu, tab.bu_lo, tab.bu_dz, tab.bu_idx)
     if i < 0:
         return math.nan
-    lnp, lnu, a, d2 = tab.lnp, tab.lnu, tab.dlnu, tab.d2lnu  # a = d ln ū/d ln p̄ at the nodes
+    return lnp_on_interval(tab.lnp, tab.lnu, tab.dlnu, tab.d2lnu, i, lnu_q)
+
+
+@njit(cache=True, inline="always")
+def lnp_on_interval(lnp, lnu, a, d2, i, lnu_q):
+    """:func:`k_lnp_of_lnu` on its interval i (``locate_desc``) from the record's arrays
+    (a = d ln ū/d ln p̄ and d2 its derivative at the nodes), for a loop that takes them out
+    of the record once: a call that passes the whole record (15 fields) by value cost ~80 ns a
+    lookup, measured on one thread (the lookup itself ~70 ns)."""
     return quintic_interval(lnu_q, lnu[i], lnu[i + 1], lnp[i], lnp[i + 1], 1.0 / a[i],
                             1.0 / a[i + 1], -d2[i] / a[i] ** 3, -d2[i + 1] / a[i + 1] ** 3)
 

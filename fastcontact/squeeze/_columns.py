@@ -1,5 +1,5 @@
-"""Output columns derived from the squeeze-out kernels' per-row results, each set in one
-parallel pass (private).
+"""Output columns derived from the squeeze-out kernels' per-row results (and from a
+history's ū(t)), each set in one parallel pass (private).
 
 A million-row study spent a fifth of its time outside the time-primitive kernel, in NumPy
 expressions that each make one pass and one temporary over the rows (the status flags, ū at
@@ -18,10 +18,12 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from ..kernels.locate import locate_desc_from
+from ..kernels.lookup import lnp_on_interval
 from ..kernels.readonly import readonly
 from ._kernels import ST_OUT, ST_OVERFLOW, ST_TRAPPED
 
-__all__ = ["status_flags", "exit_columns", "inertia_columns"]
+__all__ = ["status_flags", "exit_columns", "inertia_columns", "history_columns"]
 
 
 def _one_or_n(a):
@@ -117,3 +119,58 @@ def inertia_columns(R, rho, p, u_start, h_rms):
                      _one_or_n(1.0 if u_start is None else u_start), float(h_rms), tau,
                      tstar if u_start is not None else np.empty(0))
     return tau, tstar
+
+
+#: points per block of :func:`_history_columns` (each block walks its points in order, each
+#: lookup first trying the interval of the one before: ū(t) of sorted times is monotone)
+HISTORY_BLOCK = 1024
+
+
+@njit(parallel=True, cache=True)
+def _history_columns(tab, mp, u, h, pi0, p0, us, c_num, c_den, t, ratio, pfm, flat):
+    # the table's arrays taken out of the record once: a lookup that receives the whole
+    # record by value costs twice the lookup (kernels.lookup.lnp_on_interval)
+    n = u.size
+    for b in prange((n + HISTORY_BLOCK - 1) // HISTORY_BLOCK):
+        _history_block(tab.lnp, tab.lnu, tab.dlnu, tab.d2lnu, tab.bu_lo, tab.bu_dz, tab.bu_idx,
+                       mp.v_top, mp.x_min, mp.u0, u, h, pi0, p0, us, c_num, c_den, t, ratio,
+                       pfm, flat, b * HISTORY_BLOCK, min(b * HISTORY_BLOCK + HISTORY_BLOCK, n))
+
+
+@njit(cache=True)
+def _history_block(lnp, lnu, a, d2, blo, bdz, bidx, v_top, x_min, u0, u, h, pi0, p0, us,
+                   c_num, c_den, t, ratio, pfm, flat, k0, k1):
+    i = -1
+    for k in range(k0, k1):
+        v = u[k] / h
+        if v > v_top:  # eq. (3) tail above the table top (squeeze._kernels._lnp_of_v)
+            x = x_min - (v - v_top) / u0
+        else:
+            y = math.log(v)
+            i = locate_desc_from(y, lnu, blo, bdz, bidx, i)
+            x = math.nan if i < 0 else lnp_on_interval(lnp, lnu, a, d2, i, y)
+        r = math.exp(x) / pi0
+        ratio[k] = r
+        pfm[k] = p0 * (1.0 - r)
+        tk = t[k]
+        flat[k] = us / math.sqrt(1.0 + c_num * tk / c_den) if tk < math.inf else 0.0
+
+
+def history_columns(model, u, t, p0, E_star, eta, R, u_start):
+    """(p_cont_over_p0, p_fluid_mean [Pa], u_flat [m]) of one case's history ū(t) [m] at the
+    times t [s] (>= 0, +inf allowed), in one parallel pass.
+
+    p_cont/p0 = π_c(ū/h_rms)/(p0/E*) from the model's tables (their eq. (3) tail above the
+    top), p̄_f = p0 (1 − p_cont/p0) (eq. 19), and the Stefan law for a flat substrate from
+    the same start, ū0 [1 + 4ū0² p0 t/(3ηR²)]^{-1/2} (eq. 1 with p_cont = 0; 0 at t = inf).
+    Scalars p0 [Pa], E_star [Pa], eta [Pa·s], R [m], u_start = ū0 [m]. Same values as
+    ``model.p_of_v`` and :func:`fastcontact.squeeze.reduced.flat_separation` (bit for bit:
+    the same operations in the same order)."""
+    n = u.size
+    ratio, pfm, flat = np.empty(n), np.empty(n), np.empty(n)
+    us, p0, eta, R = (np.float64(x) for x in (u_start, p0, eta, R))
+    _history_columns(model.tab, model.mp, _one_or_n(u), float(model.h_rms),
+                     float(p0 / np.float64(E_star)), float(p0), float(us),
+                     float(4.0 * us**2 * p0), float(3.0 * eta * R**2), _one_or_n(t), ratio,
+                     pfm, flat)
+    return ratio, pfm, flat

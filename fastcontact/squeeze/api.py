@@ -18,8 +18,7 @@ from . import _kernels as qk
 from ._fastpath import fast_kernel, history_kernel, one_case_primitive, quad_kernel, row_targets
 from .model import DEFAULT_P_START, squeeze_model
 from .primitive import fast_limit
-from ._columns import status_flags
-from .reduced import flat_separation
+from ._columns import history_columns, status_flags
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.readonly import readonly_fields
 
@@ -373,13 +372,10 @@ def squeeze_history(tables, p0, E_star, R, eta, theory=DEFAULT_THEORY, t=None, u
         cs = _cases(p0, E_star, R, eta, u_start)
         out = run_cases(model, cs, np.zeros(0), np.zeros(0), t[order][:, None], "quad", quad)
         u[order] = out.U[:, 0]
-    ratio = model.p_of_v(u / h) / (float(p0) / float(E_star))
-    us = float(row["u_start"])
-    fin = np.isfinite(t)
-    flat = np.where(fin, np.asarray(flat_separation(us, np.where(fin, t, 0.0), float(p0),
-                                                    float(eta), float(R)), float), 0.0)
-    out = pd.DataFrame({"t": t, "u": u, "p_cont_over_p0": ratio,
-                        "p_fluid_mean": float(p0) * (1.0 - ratio), "u_flat": flat}, copy=False)
+    ratio, p_fluid, flat = history_columns(model, u, t, p0, E_star, eta, R,
+                                           float(row["u_start"]))
+    out = pd.DataFrame({"t": t, "u": u, "p_cont_over_p0": ratio, "p_fluid_mean": p_fluid,
+                        "u_flat": flat}, copy=False)
     out.attrs.update(df.attrs)
     out.attrs["units"] = {"t": "s", "u": "m", "p_cont_over_p0": "1", "p_fluid_mean": "Pa",
                           "u_flat": "m"}
