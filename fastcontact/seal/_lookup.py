@@ -73,30 +73,43 @@ def table_sig_d(tab, t):
 @njit(cache=True)
 def sig_d(tab, sc, t):
     """(σ̄, d ln σ̄/d t) at t = ln π; (0, -inf) at/after percolation, NaN above the table."""
-    if t < sc.t_lo:
-        s = sc.b0 + sc.b1 * (sc.t_lo - t)
-        return s * s * s, -3.0 * sc.b1 / s
-    if t >= sc.t_perc:
-        return 0.0, -math.inf
-    if t > sc.t_hi:
-        return math.nan, math.nan
-    h = sc.rh
-    u = (t - sc.rt0) / h
+    s, dl, hit = sig_d_cells(sc.t_lo, sc.t_hi, sc.t_perc, sc.b0, sc.b1, sc.rt0, sc.rh, sc.ok,
+                             sc.lns, sc.dlns, t)
+    if hit:
+        return s, dl
+    return table_sig_d(tab, t)             # unverified cell: the table's own quintic
+
+
+@njit(cache=True, inline="always")
+def sig_d_cells(t_lo, t_hi, t_perc, b0, b1, rt0, rh, ok, lns, dlns, t):
+    """:func:`sig_d` from the seal record's fields (a loop over nodes takes them out of the
+    record once: passing the seal and table records, 45 fields, to a call per node cost more
+    than the lookup): (σ̄, d ln σ̄/dt, True), or (NaN, NaN, False) in a cell the
+    re-tabulation did not verify (then ``table_sig_d`` answers)."""
+    if t < t_lo:
+        s = b0 + b1 * (t_lo - t)
+        return s * s * s, -3.0 * b1 / s, True
+    if t >= t_perc:
+        return 0.0, -math.inf, True
+    if t > t_hi:
+        return math.nan, math.nan, True
+    h = rh
+    u = (t - rt0) / h
     k = int(u)
-    if k >= 0 and k < sc.ok.size and sc.ok[k]:
+    if k >= 0 and k < ok.size and ok[k]:
         x = u - k
         x2 = x * x
         x3 = x2 * x
-        y0 = sc.lns[k]
-        y1 = sc.lns[k + 1]
-        d0 = sc.dlns[k] * h
-        d1 = sc.dlns[k + 1] * h
+        y0 = lns[k]
+        y1 = lns[k + 1]
+        d0 = dlns[k] * h
+        d1 = dlns[k + 1] * h
         y = ((2 * x3 - 3 * x2 + 1) * y0 + (x3 - 2 * x2 + x) * d0 + (-2 * x3 + 3 * x2) * y1
              + (x3 - x2) * d1)
         dy = ((6 * x2 - 6 * x) * y0 + (3 * x2 - 4 * x + 1) * d0 + (-6 * x2 + 6 * x) * y1
               + (3 * x2 - 2 * x) * d1) / h
-        return math.exp(y), dy
-    return table_sig_d(tab, t)             # unverified cell: the table's own quintic
+        return math.exp(y), dy, True
+    return math.nan, math.nan, False
 
 
 @njit(cache=True)

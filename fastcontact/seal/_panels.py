@@ -41,11 +41,13 @@ import numpy as np
 from numba import njit, prange
 
 from ..kernels._index import INT0, INT1
+from ..kernels.borrow import borrowed
 from ._mesh import (array_zone, geometry, interp_series, panel_series, remaining_fraction,
                     solve_small, zone_params)
 from ._panel_records import Mesh, State, Work, Zone, _work
 from ._roelands_psi import fluid_of, no_psi_table, psi_eta, psi_of, psi_table
-from ._sigma import sig_d
+from ._lookup import sig_d_cells
+from ._sigma import table_sig_d
 
 __all__ = ["solve_case", "solve_robust", "solve_row", "solve_rows", "solve_rows_chained", "ST_OK",
            "ST_NOT_REFINED",
@@ -143,13 +145,20 @@ def _resid(tab, sc, rule, st, dxi, eb, dpi, al, rt, pan, P):
     n, wl, At = rule.n, rule.wl, rule.At
     c, r, D, Rt, F, er_ = st
     N = P * n
+    t_lo, t_hi, t_perc, b0, b1, rt0, rh = sc.t_lo, sc.t_hi, sc.t_perc, sc.b0, sc.b1, sc.rt0, sc.rh
+    okc, lns, dlns = sc.ok, sc.lns, sc.dlns
     for i in range(N):
         ci = c[i]
         if ci <= 0.0:
             r[i] = 0.0
             D[i] = 0.0
             continue
-        s, dl = sig_d(tab, sc, math.log(ci))
+        lc = math.log(ci)
+        # sig_d on the record's fields taken out once (a call with both records per node cost
+        # more than the lookup)
+        s, dl, hit = sig_d_cells(t_lo, t_hi, t_perc, b0, b1, rt0, rh, okc, lns, dlns, lc)
+        if not hit:
+            s, dl = table_sig_d(tab, lc)
         if not s > 0.0:
             return 0.0, math.inf, False
         r[i] = dxi[i] / s
@@ -171,6 +180,7 @@ def _resid(tab, sc, rule, st, dxi, eb, dpi, al, rt, pan, P):
         return W, math.inf, False
     fmax = 0.0
     roel = rt.y.size > 0
+    rt = borrowed(rt)  # psi_eta inline: no reference counts per node
     for i in range(N):
         if roel:
             ps, er = psi_eta(rt, eb[i] - c[i])

@@ -28,6 +28,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, prange
 
+from ..kernels.borrow import borrowed
 from ..kernels.hermite import quintic_unit
 from ..kernels.quadrature import gauss_legendre
 
@@ -117,7 +118,7 @@ def psi_of(rt, pi):
     return _psi_at(rt, pi, math.log1p(pi / rt.pr))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def psi_eta(rt, pi):
     """(ψ(π), η/η0 at π): :func:`psi_of` and the law's η/η0 (ln η/η0 = A[(1 + π/π_r)^Z - 1],
     as :func:`fastcontact.flow.piezoviscosity.ln_roelands`) sharing u = ln(1 + π/π_r)."""
@@ -133,6 +134,7 @@ def fluid_of(rt, psi):
     docstring; to a step of 1e-15 π)."""
     if psi <= 0.0:
         return psi
+    rt = borrowed(rt)  # psi_eta inline: no reference counts per iteration
     n = rt.y.size - 1
     if psi >= rt.y[n]:  # beyond the table: its linear continuation
         u_end = n * rt.h
