@@ -73,6 +73,14 @@ def table_sig_d(tab, t):
 @njit(cache=True)
 def sig_d(tab, sc, t):
     """(σ̄, d ln σ̄/d t) at t = ln π; (0, -inf) at/after percolation, NaN above the table."""
+    return sig_d_at(tab, sc, t)
+
+
+@njit(cache=True, inline="always")
+def sig_d_at(tab, sc, t):
+    """:func:`sig_d` inline, for loops over nodes on borrowed records
+    (:mod:`fastcontact.kernels.borrow`): a call per node that passes both records by value
+    cost more than the lookup."""
     s, dl, hit = sig_d_cells(sc.t_lo, sc.t_hi, sc.t_perc, sc.b0, sc.b1, sc.rt0, sc.rh, sc.ok,
                              sc.lns, sc.dlns, t)
     if hit:

@@ -16,7 +16,7 @@ from numba import njit
 
 from ..kernels.hermite import _quintic_value, quintic_interval
 from ..kernels.borrow import borrowed
-from ._lookup import sig_d, sig_d_cells, table_sig_d
+from ._lookup import sig_d, sig_d_at
 
 __all__ = ["build_primitive", "asym_primitive", "ADAPT_RTOL", "P_COLS"]
 
@@ -31,15 +31,6 @@ P_COLS = 8
 
 
 # =========================================================================== direct integrals
-@njit(cache=True, inline="always")
-def _sigma_nodes(tab, sc, t):
-    """σ̄ at t = ln π: :func:`~._lookup.sig_d`'s value, from the seal record's fields (a
-    call per node that passes both records by value cost more than the lookup)."""
-    s, _dl, hit = sig_d_cells(sc.t_lo, sc.t_hi, sc.t_perc, sc.b0, sc.b1, sc.rt0, sc.rh, sc.ok,
-                              sc.lns, sc.dlns, t)
-    return s if hit else table_sig_d(tab, t)[0]
-
-
 @njit(cache=True)
 def _gl_t(tab, sc, a, b):
     """∫_a^b σ̄(e^t) e^t dt, fixed Gauss–Legendre (sc.glx, sc.glw)."""
@@ -49,7 +40,7 @@ def _gl_t(tab, sc, a, b):
     acc = 0.0
     for k in range(sc.glx.size):
         t = mid + half * sc.glx[k]
-        acc += sc.glw[k] * _sigma_nodes(tab, sc, t) * math.exp(t)
+        acc += sc.glw[k] * sig_d_at(tab, sc, t)[0] * math.exp(t)
     return acc * half
 
 
@@ -61,7 +52,7 @@ def _gl_s(tab, sc, hi, s0, s1):
     mid = s0 + half
     acc = 0.0
     for k in range(sc.glx.size):
-        acc += sc.glw[k] * _sigma_nodes(tab, sc, math.log(hi - (mid + half * sc.glx[k])))
+        acc += sc.glw[k] * sig_d_at(tab, sc, math.log(hi - (mid + half * sc.glx[k])))[0]
     return acc * half
 
 
