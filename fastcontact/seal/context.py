@@ -21,7 +21,7 @@ from . import _panels, _sigma
 __all__ = ["SealRecord", "SealContext", "seal_context", "PanelRule", "RowsOut", "panel_rule",
            "solver_options", "SOLVER_DEFAULTS", "RETAB_H", "RETAB_TOL", "PRIM_H", "PRIM_GL",
            "PRIM_DEPTH", "TAIL_SPLIT", "NEAR_LIFT_OFF", "EQUALITY_TOL", "solve_profile_rows",
-           "peak_past_trust"]
+           "dealt", "peak_past_trust"]
 
 #: re-tabulation of ln σ̄ (uniform in ln π): spacing and per-cell verification tolerance
 RETAB_H = 1.0 / 64.0
@@ -420,8 +420,22 @@ def solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, near, al=None, 
                                        order, starts, out)
             continue
         _panels.solve_rows(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pia, pib, al, vis,
-                           np.ascontiguousarray(sel, dtype=np.int64), out)
+                           dealt(sel), out)
     return out
+
+
+def dealt(idx):
+    """The row indices ``idx`` as contiguous int64, dealt to the threads: rows 0, T, 2T, ...
+    first, then 1, T+1, ... (T = numba's threads). :func:`._panels.solve_rows` gives each
+    thread one contiguous block of the rows; where they come sorted (grid lines of a table, a
+    study ordered by load) that block would hold all the cheap or all the costly rings. Each
+    row's result is its own: the same whatever the order."""
+    from numba import get_num_threads
+    idx = np.ascontiguousarray(idx, dtype=np.int64)
+    T = get_num_threads()
+    if T < 2 or idx.size < 2 * T:
+        return idx
+    return np.ascontiguousarray(np.concatenate([idx[t::T] for t in range(T)]))
 
 
 #: most rows per chain of :func:`._panels.solve_rows_chained`; a batch is cut into about one
@@ -444,8 +458,28 @@ def _chains(sel, amp, pia, pib, al, vis):
     first = np.flatnonzero(new)
     pos = np.arange(sel.size) - first[run]
     starts = np.flatnonzero(new | (pos % L == 0))
-    return (np.ascontiguousarray(sel[order], dtype=np.int64),
-            np.append(starts, sel.size).astype(np.int64))
+    rows, starts = spread_chains(sel[order], np.append(starts, sel.size),
+                                 get_num_threads())
+    return (np.ascontiguousarray(rows, dtype=np.int64),
+            np.ascontiguousarray(starts, dtype=np.int64))
+
+
+def spread_chains(rows, bounds, threads):
+    """(rows, bounds) with the chains rows[bounds[c]:bounds[c+1]] dealt to ``threads``
+    blocks: chains 0, T, 2T, ... first, then 1, T+1, ... (T = threads; each chain's rows in
+    their order). A parallel loop gives each thread one contiguous block of the chains; sorted
+    by π_H, one thread would get the cheap rings and the other the costly ones and the call
+    would wait for the slower, while each block dealt this way spans every π_H in its sorted
+    order (neighbouring rings read neighbouring table cells)."""
+    nc = bounds.size - 1
+    if nc < 2 * threads or threads < 2:
+        return rows, bounds
+    perm = np.concatenate([np.arange(t, nc, threads) for t in range(threads)])
+    lens = np.diff(bounds)[perm]
+    nb = np.zeros(nc + 1, dtype=np.int64)
+    np.cumsum(lens, out=nb[1:])
+    pos = np.arange(rows.size) - np.repeat(nb[:-1], lens) + np.repeat(bounds[:-1][perm], lens)
+    return rows[pos], nb
 
 
 def new_runs(keys, order):
