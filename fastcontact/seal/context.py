@@ -14,6 +14,7 @@ import numpy as np
 
 from .._core.cache import PerObjectCache
 from ..flow.conductivity import check_theory
+from ..kernels.balance import spread_order
 from ..kernels.quadrature import gauss_legendre
 from ..tables.build import SIGMA_FLOOR
 from . import _panels, _sigma
@@ -425,17 +426,13 @@ def solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, near, al=None, 
 
 
 def dealt(idx):
-    """The row indices ``idx`` as contiguous int64, dealt to the threads: rows 0, T, 2T, ...
-    first, then 1, T+1, ... (T = numba's threads). :func:`._panels.solve_rows` gives each
+    """The row indices ``idx`` as contiguous int64 in the order of
+    :func:`~fastcontact.kernels.balance.spread_order`. :func:`._panels.solve_rows` gives each
     thread one contiguous block of the rows; where they come sorted (grid lines of a table, a
-    study ordered by load) that block would hold all the cheap or all the costly rings. Each
-    row's result is its own: the same whatever the order."""
-    from numba import get_num_threads
+    study ordered by load) one block would hold all the cheap rings and another all the costly
+    ones. Each row's result is its own: the same whatever the order."""
     idx = np.ascontiguousarray(idx, dtype=np.int64)
-    T = get_num_threads()
-    if T < 2 or idx.size < 2 * T:
-        return idx
-    return np.ascontiguousarray(np.concatenate([idx[t::T] for t in range(T)]))
+    return np.ascontiguousarray(idx[spread_order(idx.size)])
 
 
 #: most rows per chain of :func:`._panels.solve_rows_chained`; a batch is cut into about one
@@ -458,23 +455,19 @@ def _chains(sel, amp, pia, pib, al, vis):
     first = np.flatnonzero(new)
     pos = np.arange(sel.size) - first[run]
     starts = np.flatnonzero(new | (pos % L == 0))
-    rows, starts = spread_chains(sel[order], np.append(starts, sel.size),
-                                 get_num_threads())
+    rows, starts = spread_chains(sel[order], np.append(starts, sel.size))
     return (np.ascontiguousarray(rows, dtype=np.int64),
             np.ascontiguousarray(starts, dtype=np.int64))
 
 
-def spread_chains(rows, bounds, threads):
-    """(rows, bounds) with the chains rows[bounds[c]:bounds[c+1]] dealt to ``threads``
-    blocks: chains 0, T, 2T, ... first, then 1, T+1, ... (T = threads; each chain's rows in
-    their order). A parallel loop gives each thread one contiguous block of the chains; sorted
-    by π_H, one thread would get the cheap rings and the other the costly ones and the call
-    would wait for the slower, while each block dealt this way spans every π_H in its sorted
-    order (neighbouring rings read neighbouring table cells)."""
+def spread_chains(rows, bounds):
+    """(rows, bounds) with the chains rows[bounds[c]:bounds[c+1]] in the order of
+    :func:`~fastcontact.kernels.balance.spread_order` (each chain's rows in their order). A
+    parallel loop gives each thread one contiguous block of the chains; sorted by π_H, one
+    thread would get the cheap rings and another the costly ones and the call would wait for
+    the slowest, while every contiguous block of the spread order samples all π_H."""
     nc = bounds.size - 1
-    if nc < 2 * threads or threads < 2:
-        return rows, bounds
-    perm = np.concatenate([np.arange(t, nc, threads) for t in range(threads)])
+    perm = spread_order(nc)
     lens = np.diff(bounds)[perm]
     nb = np.zeros(nc + 1, dtype=np.int64)
     np.cumsum(lens, out=nb[1:])
