@@ -22,7 +22,7 @@ from . import _panels, _sigma
 __all__ = ["SealRecord", "SealContext", "seal_context", "PanelRule", "RowsOut", "panel_rule",
            "solver_options", "SOLVER_DEFAULTS", "RETAB_H", "RETAB_TOL", "PRIM_H", "PRIM_GL",
            "PRIM_DEPTH", "TAIL_SPLIT", "NEAR_LIFT_OFF", "EQUALITY_TOL", "solve_profile_rows",
-           "dealt", "peak_past_trust"]
+           "spread_rows", "peak_past_trust"]
 
 #: re-tabulation of ln σ̄ (uniform in ln π): spacing and per-cell verification tolerance
 RETAB_H = 1.0 / 64.0
@@ -421,18 +421,17 @@ def solve_profile_rows(sc, o, kind, xg, p0n, amp, pia, pib, idx, near, al=None, 
                                        order, starts, out)
             continue
         _panels.solve_rows(sc.tab, sc.rec, rule, kind, xg, p0n, amp, pia, pib, al, vis,
-                           dealt(sel), out)
+                           spread_rows(sel), out)
     return out
 
 
-def dealt(idx):
+def spread_rows(idx):
     """The row indices ``idx`` as contiguous int64 in the order of
     :func:`~fastcontact.kernels.balance.spread_order`. :func:`._panels.solve_rows` gives each
     thread one contiguous block of the rows; where they come sorted (grid lines of a table, a
     study ordered by load) one block would hold all the cheap rings and another all the costly
     ones. Each row's result is its own: the same whatever the order."""
-    idx = np.ascontiguousarray(idx, dtype=np.int64)
-    return np.ascontiguousarray(idx[spread_order(idx.size)])
+    return np.asarray(idx, dtype=np.int64)[spread_order(idx.size)]
 
 
 #: most rows per chain of :func:`._panels.solve_rows_chained`; a batch is cut into about one
@@ -455,9 +454,7 @@ def _chains(sel, amp, pia, pib, al, vis):
     first = np.flatnonzero(new)
     pos = np.arange(sel.size) - first[run]
     starts = np.flatnonzero(new | (pos % L == 0))
-    rows, starts = spread_chains(sel[order], np.append(starts, sel.size))
-    return (np.ascontiguousarray(rows, dtype=np.int64),
-            np.ascontiguousarray(starts, dtype=np.int64))
+    return spread_chains(np.asarray(sel[order], dtype=np.int64), np.append(starts, sel.size))
 
 
 def spread_chains(rows, bounds):

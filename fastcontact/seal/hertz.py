@@ -37,7 +37,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _hertz, _panels
-from .context import RowsOut, dealt, panel_rule, solver_options
+from .context import RowsOut, panel_rule, solver_options, spread_rows
 
 __all__ = ["HertzTable", "hertz_table", "table_W", "HertzPbTable", "hertz_pb_table", "table_W_pb",
            "tabled_W", "hertz_beta_table", "table_W_beta", "H1", "NY", "NZ", "NB", "B_MAX",
@@ -134,7 +134,7 @@ def _solve_W(sc, piH, pia, equal, al=0.0, vis=None, pib=None):
         rule = panel_rule(o, tol=1e-9 if eq else TABLE_TOL, max_panels=256)
         _panels.solve_rows(sc.tab, sc.rec, rule, 0, np.zeros(2), np.zeros(2),
                            np.ascontiguousarray(piH), np.ascontiguousarray(pia),
-                           pib, alr, law, dealt(idx), out)
+                           pib, alr, law, spread_rows(idx), out)
     return np.where(out.status == _panels.ST_NEWTON_FAILED, np.nan, out.W)
 
 

@@ -1,9 +1,10 @@
-"""Rows and chains of the soft-seal solver dealt to the threads (fastcontact.seal.context).
+"""Rows and chains of the soft-seal solver spread over the threads (fastcontact.seal.context).
 
 A parallel loop gives each thread one contiguous block of its iterations; the seal solver's
-rows often come sorted (grid lines of a table, chains sorted by p_H), so the rows are dealt
-(0, T, 2T, ... then 1, T+1, ...) before the loop. Dealing may change the time a call takes,
-never a result: each row (each chain) is solved on its own.
+rows often come sorted (grid lines of a table, chains sorted by p_H), so the rows and chains
+go to the loop in the van der Corput order of fastcontact.kernels.balance.spread_order. The
+order may change the time a call takes, never a result: each row (each chain) is solved on
+its own.
 """
 from __future__ import annotations
 
@@ -54,9 +55,9 @@ def test_spread_chains_keeps_every_chain_whole_and_spreads_them(nc):
 
 
 @pytest.mark.parametrize("n", [0, 1, 3, 47, 500])
-def test_dealt_is_a_spread_permutation(n):
+def test_spread_rows_is_a_spread_permutation(n):
     idx = (np.arange(n, dtype=np.int32) + 3) * 7
-    got = context.dealt(idx)
+    got = context.spread_rows(idx)
     assert got.dtype == np.int64 and got.flags.c_contiguous
     assert sorted(got.tolist()) == idx.tolist()
     if n > 2:
