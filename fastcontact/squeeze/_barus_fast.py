@@ -18,6 +18,7 @@ from collections import namedtuple
 import numpy as np
 from numba import get_thread_id, njit, prange
 
+from ..kernels.balance import spread_blocks
 from ..kernels.borrow import borrowed
 
 from ._barus_primitive import (BINOMIALS, K_MAX, BarusTable, s_at, s_cell, s_value,
@@ -137,9 +138,13 @@ def squeeze_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, q
     Blocks of :data:`~._fastpath.BLOCK` cases in parallel, each one call of
     :func:`_squeeze_block`: the case body is compiled as a plain function, outside numba's
     parfor passes (whose cost grows faster than the body: the body inline in this loop took
-    ~60 s of compiling on 2 cores; a call per block costs nothing measurable)."""
+    ~60 s of compiling on 2 cores; a call per block costs nothing measurable), visited in
+    :func:`~fastcontact.kernels.balance.spread_blocks` order (the per-case quadrature rows of
+    a study sorted by pressure spread over the threads, as in :func:`~._fastpath.fast_kernel`)."""
     n = cs.p0.size
-    for blk in prange((n + BLOCK - 1) // BLOCK):
+    order = spread_blocks((n + BLOCK - 1) // BLOCK)
+    for q in prange(order.size):
+        blk = order[q]
         _squeeze_block(tab, sc, pr, bt, c, x_fast, cs, alpha, h, tg, zt, lnTs, sb, quad, out,
                        scratch, blk * BLOCK, min(blk * BLOCK + BLOCK, n))
 
@@ -205,7 +210,9 @@ def tire_kernel(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb
     u_exit NaN) from the primitive where it serves the case, else the per-case quadrature;
     blocks of cases in parallel as :func:`squeeze_kernel` (:func:`_tire_block`)."""
     n = cs.p0.size
-    for blk in prange((n + BLOCK - 1) // BLOCK):
+    order = spread_blocks((n + BLOCK - 1) // BLOCK)
+    for q in prange(order.size):
+        blk = order[q]
         _tire_block(tab, sc, pr, bt, c, x_fast, cs, alpha, t_fp, h, tg, zt, lnTs, sb, quad,
                     out, scratch, blk * BLOCK, min(blk * BLOCK + BLOCK, n))
 

@@ -18,6 +18,7 @@ from ._primitive_eval import (inverse_constants, inverse_constants_ext, tail_top
                               z_of_t_from)
 from .primitive import Primitive, first_row, row_value, stencil, t_of_z
 from ._primitive_eval import lagrange_denominators, one_plus_exp, t_of_zv
+from ..kernels.balance import spread_blocks
 from ..kernels.borrow import borrowed
 from ..kernels.readonly import readonly_fields
 
@@ -302,14 +303,19 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales):
     The parallel body is one call per block: the per-case work (its helpers inline) is
     compiled as a plain function, outside numba's parfor passes, whose cost grows faster than
     the body (a body of the whole block inline here took ~65 s of compiling on 2 cores; a call
-    per block of 128 cases costs nothing measurable)."""
+    per block of 128 cases costs nothing measurable). The blocks are visited in
+    :func:`~fastcontact.kernels.balance.spread_blocks` order: numba gives each thread one
+    contiguous run of them, and a study sorted by pressure would hand every fall-back row
+    (quadrature: trapped fluid, x0 beyond the primitive) to the last thread."""
     nr = tg.ratios.size
     r1s = np.empty(1 + nr)  # ū/ū∞ - 1 of t_star and the ratios, and its log
     r1s[0] = 0.01
     r1s[1:] = tg.ratios - 1.0
     zt = ZTargets(r1s, np.log(r1s), tg.dvs, rt.lnT, same_targets(r1s, tg.dvs))
     n = cs.p0.size
-    for blk in prange((n + BLOCK - 1) // BLOCK):
+    order = spread_blocks((n + BLOCK - 1) // BLOCK)
+    for q in prange(order.size):
+        blk = order[q]
         _fast_block(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales, zt,
                     blk * BLOCK, min(blk * BLOCK + BLOCK, n))
 
