@@ -258,6 +258,15 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=No
     with it. A start 2e-4 above the target gives up to ~1e-5 relative (the absolute error
     stays ≤ 1e-9 t*); the same target with ``method="quad"`` is exact to its quadrature.
 
+    ``t_trap`` is the one exception. On a trapped row it is the time to reach ū_trap, the
+    separation where σ̄ collapses to the trap floor ``sigma_trap`` (default the tables'
+    ``sigma_floor``, 1e-24), so it scales as 1/sigma_trap: 3e19–1e22 τ0 on the four embedded
+    surfaces (critical junction and EMT, ln π0 0.02–0.7 above ln π_trap). Read it as "never
+    drains", not as a drainage time. It comes from the per-case quadrature, whose unit
+    panels in ln(ū - ū_trap) do not resolve the table nodes that σ̄'s collapse crosses. It is
+    within 5e-3 relative of a converged quadrature (measured 1.6e-7 to 4.1e-3, the worst on
+    ``asphalt_024mm`` with EMT).
+
     References
     ----------
     B. Lorenz and B.N.J. Persson, Eur. Phys. J. E 32, 281 (2010), arXiv:1004.1037.
