@@ -9,6 +9,8 @@ its own.
 from __future__ import annotations
 
 import math
+import os
+import sys
 
 import numpy as np
 import pytest
@@ -16,6 +18,9 @@ import pytest
 import fastcontact as fc
 from fastcontact.seal import context
 from fastcontact.seal.viscosity import seal_leak_piezo
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from spread_checks import runs_sample_the_range  # noqa: E402
 
 E_STAR = 1e7
 
@@ -29,14 +34,10 @@ def _random_chains(rng, nc):
 
 
 def _samples_evenly(where, n, threads):
-    """Every block of a static split of ``where`` (original positions in a sorted range of n)
-    into 1..threads blocks spans the range with gaps of at most ~2n/k (k its length)."""
+    """Every static split of ``where`` (original positions in a sorted range of n) into
+    1..threads blocks samples the whole range (:func:`spread_checks.runs_sample_the_range`)."""
     for T in range(1, min(threads, n) + 1):
-        for blk in np.array_split(np.asarray(where), T):
-            gap = 2 * math.ceil(n / blk.size) + 1
-            srt = np.sort(blk)
-            assert srt[0] < gap and srt[-1] >= n - gap, (T, srt)
-            assert np.diff(srt).max(initial=0) <= gap, (T, srt)
+        assert runs_sample_the_range(where, n, T), (T, where)
 
 
 @pytest.mark.parametrize("nc", [1, 2, 5, 8, 37, 200])

@@ -11,6 +11,8 @@ shuffled inputs give the same rows bit for bit.
 from __future__ import annotations
 
 import math
+import os
+import sys
 
 import numpy as np
 import pytest
@@ -20,6 +22,10 @@ from fastcontact.squeeze import squeeze_out
 from fastcontact.squeeze.tire import tire_footprint
 from fastcontact.tables import Tables
 from fastcontact.tables.defaults import default_table_path
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from frames import assert_columns_match  # noqa: E402
+from spread_checks import runs_sample_the_range  # noqa: E402
 
 E_STAR = 13e6
 
@@ -41,24 +47,13 @@ def test_spread_blocks_is_the_van_der_corput_order(n):
     assert np.array_equal(got, spread_order(n))
 
 
-def _runs_sample_the_range(order, n, threads):
-    """Every run of a static split of ``order`` into ``threads`` runs spans range(n) with
-    gaps of at most ~2n/k (k the run's length)."""
-    for run in np.array_split(order, threads):
-        srt = np.sort(run)
-        gap = 2 * math.ceil(n / run.size) + 1
-        if not (srt[0] < gap and srt[-1] >= n - gap and np.diff(srt).max(initial=0) <= gap):
-            return False
-    return True
-
-
 @pytest.mark.parametrize("n", [64, 300, 7813])
 def test_every_static_run_of_blocks_samples_the_whole_range(n):
     order = spread_blocks(n)
     for threads in (2, 3, 4):
-        assert _runs_sample_the_range(order, n, threads), threads
+        assert runs_sample_the_range(order, n, threads), threads
         # the blocks in their own order fail the check (one thread, the last blocks)
-        assert not _runs_sample_the_range(np.arange(n), n, threads)
+        assert not runs_sample_the_range(np.arange(n), n, threads)
 
 
 @pytest.fixture(scope="module")
@@ -76,13 +71,9 @@ def _pressures(tables, n, seed):
 
 
 def _same_rows(a, b):
+    """Bit for bit: the same columns, floats equal (NaN where NaN), others exactly."""
     assert list(a.columns) == list(b.columns)
-    for c in a.columns:
-        x, y = a[c].to_numpy(), b[c].to_numpy()
-        if x.dtype.kind == "f":
-            assert np.array_equal(x, y, equal_nan=True), c
-        else:
-            assert (x == y).all(), c
+    assert_columns_match(a, b, b.columns, rtol=0.0)
 
 
 def _orders(n, seed):
