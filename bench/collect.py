@@ -11,7 +11,7 @@ import os
 from pathlib import Path
 
 HERE = Path(__file__).parent
-ORDER = ["tables", "squeeze", "first_call", "alloc", "seal", "sweep", "run_memory", "fuzz", "fuzz_extensions", "extensions",
+ORDER = ["tables", "squeeze", "trapped", "first_call", "alloc", "seal", "sweep", "run_memory", "fuzz", "fuzz_extensions", "extensions",
          "calibration_integration", "layout", "kernel_inputs", "compile"]
 #: fragments whose script name differs from bench_<name>.py
 SCRIPT = {"run_memory": "bench_run_memory.py",

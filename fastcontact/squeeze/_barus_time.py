@@ -46,6 +46,7 @@ from ..kernels.readonly import readonly, readonly_fields
 from . import _kernels as qk
 from ._barus_primitive import API_FAST, K_MAX, s_at, s_cell, series_order, shift
 from ._fastpath import fast_kernel, row_targets
+from ._trap_primitive import empty as _NONE_TRAPPED  # Barus rows: trapped ones by quadrature
 from ._primitive_eval import (Primitive, _index_map, _locate, lagrange_denominators,
                               row_value, stencil)
 from .viscosity import _rate_factor, _rate_factor_array
@@ -379,13 +380,15 @@ def tire_rows(model, bg, cs, t_fp, h, ratios, dvs, quad, res, idx):
         U = res.u_exit.reshape(1, -1) if t_fp.size else np.empty((0, ng))
         out = qk.SqOut(res.T, U, res.u_inf, res.u_start, np.empty(ng), res.u_trap,
                        np.empty(ng), res.flf, np.empty(ng), res.status)
-        fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, csg, h, tg, quad, out, False)
+        fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, *_NONE_TRAPPED(), csg, h, tg,
+                    quad, out, False)
         if not t_fp.size:
             res.u_exit[:] = math.nan
         return
     out = qk.SqOut(np.empty((res.T.shape[0], ng)), np.empty((tg.times.shape[0], ng)),
                    *(np.empty(ng) for _ in range(7)), qk.new_status(ng))
-    fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, csg, h, tg, quad, out, False)
+    fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, *_NONE_TRAPPED(), csg, h, tg,
+                quad, out, False)
     qk.check_computed(out.status, "tire_footprint(alpha_pv=...)")
     res.T[:, idx] = out.T
     res.u_exit[idx] = out.U[0] if t_fp.size else math.nan
@@ -432,7 +435,8 @@ def squeeze_rows(model, bg, cs, tg, h, quad, out, idx):
         o = qk.SqOut(np.empty((out.T.shape[0], ng)), np.empty((times2d.shape[0], ng)),
                      *(np.empty(ng) for _ in range(7)), code)
         gs = np.empty(ng)
-    fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, csg, h, tgb, quad, o, True)
+    fast_kernel(model.tab, model.mp, bg.pr, rt, bg.x_served, *_NONE_TRAPPED(), csg, h, tgb,
+                quad, o, True)
     qk.check_computed(code, "squeeze_out(alpha_pv=...)")  # before the codes become statuses
     # the default start is where p_cont = DEFAULT_P_START p0: y there needs no table
     y_default = DEFAULT_P_START if np.isnan(us).all() else -1.0

@@ -2,8 +2,10 @@
 
 Every output is a few interpolations of the primitive T(x0, ū) per case
 (:mod:`fastcontact.squeeze.primitive`): t(a → b) = τ0 [T(b) - T(a)], ū(t) from
-T(ū) = T(ū_start) + t/τ0. Rows the primitive does not serve (trapped fluid, p0 within 4.4 % of
-the trap pressure) fall back to the per-case quadrature in the same pass.
+T(ū) = T(ū_start) + t/τ0. Trapped rows (p0 above the trap pressure) come from the trapped
+side's primitive (:mod:`._trap_primitive`); the rows neither serves (p0 within 4.4 % below the
+trap pressure or less than 1e-4 above it in ln p0, outside the tables) fall back to the
+per-case quadrature in the same pass.
 """
 from __future__ import annotations
 
@@ -18,6 +20,7 @@ from ._primitive_eval import (inverse_constants, inverse_constants_ext, tail_top
                               z_of_t_from)
 from .primitive import Primitive, first_row, row_value, stencil, t_of_z
 from ._primitive_eval import lagrange_denominators, one_plus_exp, t_of_zv
+from ._trap_primitive import trap_row
 from ..kernels.balance import spread_blocks
 from ..kernels.borrow import borrowed
 from ..kernels.readonly import readonly_fields
@@ -284,7 +287,7 @@ def _st_of(scr, c):
 
 
 @njit(parallel=True, cache=True)
-def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales):
+def fast_kernel(tab, mp, pr, rt, x_fast, tlo, thi, ttr, cs, h, tg, quad, out, timescales):
     """method="fast": every case from the primitive (fall-back rows by quadrature).
 
     Each parallel iteration takes a block of :data:`BLOCK` cases (:func:`_fast_block`) through
@@ -306,7 +309,11 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales):
     per block of 128 cases costs nothing measurable). The blocks are visited in
     :func:`~fastcontact.kernels.balance.spread_blocks` order: numba gives each thread one
     contiguous run of them, and a study sorted by pressure would hand every fall-back row
-    (quadrature: trapped fluid, x0 beyond the primitive) to the last thread."""
+    (quadrature: x0 next to the trap pressure or outside the tables) to the last thread.
+
+    Trapped rows (x0 from ``ttr.x_lo`` to ``ttr.x_hi``) come from the trapped side's primitive
+    ``tlo``, ``thi``, ``ttr`` (:mod:`._trap_primitive`; its ``empty()`` serves none), one case
+    at a time (:func:`~._trap_primitive.trap_row`)."""
     nr = tg.ratios.size
     r1s = np.empty(1 + nr)  # ū/ū∞ - 1 of t_star and the ratios, and its log
     r1s[0] = 0.01
@@ -316,16 +323,19 @@ def fast_kernel(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales):
     order = spread_blocks((n + BLOCK - 1) // BLOCK)
     for q in prange(order.size):
         blk = order[q]
-        _fast_block(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales, zt,
-                    blk * BLOCK, min(blk * BLOCK + BLOCK, n))
+        _fast_block(tab, mp, pr, rt, x_fast, tlo, thi, ttr, cs, h, tg, quad, out, timescales,
+                    zt, blk * BLOCK, min(blk * BLOCK + BLOCK, n))
 
 
 @njit(cache=True)
-def _fast_block(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales, zt, b0, b1):
+def _fast_block(tab, mp, pr, rt, x_fast, tlo, thi, ttr, cs, h, tg, quad, out, timescales, zt,
+                b0, b1):
     """Cases b0 <= i < b1 of :func:`fast_kernel`, stage by stage (``zt`` its
     :data:`ZTargets`). The records are borrowed (:mod:`fastcontact.kernels.borrow`): each
     inline helper's copy of a record would otherwise count references on every array in it."""
     tab, mp, pr, rt, cs, tg, quad, out, zt = borrowed((tab, mp, pr, rt, cs, tg, quad, out, zt))
+    tlo, thi, ttr = borrowed((tlo, thi, ttr))
+    xt_lo, xt_hi = ttr.x_lo, ttr.x_hi
     T_out = out.T
     U_out = out.U
     tau0 = out.tau0
@@ -359,7 +369,11 @@ def _fast_block(tab, mp, pr, rt, x_fast, cs, h, tg, quad, out, timescales, zt, b
             tau0[i] = tau
         scr[c, _LIVE] = 0.0
         if not (x_lo <= x0 <= x_hi):
-            _slow_row(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
+            if xt_lo <= x0 <= xt_hi:
+                trap_row(tab, mp, tlo, thi, ttr, x0, vs_in, tg, tau, h, i, out)
+                _flag_overflow(tau, tg, h, i, out)
+            else:
+                _slow_row(tab, mp, x0, vs_in, tg, tau, h, quad, i, out)
             continue
         st = stencil(pr, x0)
         vinf = math.exp(row_value(pr.lnv, st))

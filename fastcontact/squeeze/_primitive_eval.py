@@ -18,7 +18,7 @@ from ..kernels.hermite import quintic_unit
 from . import _kernels as qk
 
 __all__ = ["Primitive", "first_row", "stencil", "row_value", "row_value_2", "t_of_z", "t_of_zv",
-           "z_of_t", "z_of_t_at", "z_of_t_from", "inverse_constants", "inverse_constants_ext", "tail_top",
+           "z_of_t", "z_of_t_at", "z_of_t_from", "cell_root", "inverse_constants", "inverse_constants_ext", "tail_top",
            "lagrange_denominators", "one_plus_exp", "Z_NEGLIGIBLE"]
 
 #: the tabulated primitive (reduced units). xn (nx) x0 nodes and their locator (blo, bdz,
@@ -271,8 +271,14 @@ def z_of_t_at(pr, st, vinf, T, ic):
             if abs(dzn) <= 1e-13 * (1.0 + abs(z)):  # beyond the round-off of T: would stall
                 break
         return z - lk
-    lt = math.log(T)
-    # bracket: combined ln T at the nodes decreases with k
+    return cell_root(pr, st, math.log(T)) - lk
+
+
+@njit(cache=True, inline="always")
+def cell_root(pr, st, y):
+    """z of the grid (before the ln κ shift) where the combined quintic of the node values
+    C[..., 0] (decreasing with k) equals y: the cell by bisection over the nodes, then the
+    cell's Halley iteration (:func:`_halley_cell`)."""
     lo = 0
     hi = pr.nz - 1
     y_lo = row_value_2(pr.C, st, lo)
@@ -280,15 +286,15 @@ def z_of_t_at(pr, st, vinf, T, ic):
     while hi - lo > 1:
         mid = (lo + hi) // 2
         y_mid = row_value_2(pr.C, st, mid)
-        if y_mid >= lt:
+        if y_mid >= y:
             lo = mid
             y_lo = y_mid
         else:
             hi = mid
             y_hi = y_mid
     cf = _cell(pr, st, lo)
-    t = _halley_cell(cf, pr.dz, lt, _inverse_guess(cf, pr.dz, y_lo, y_hi, lt))
-    return pr.z0 + (lo + t) * pr.dz - lk
+    t = _halley_cell(cf, pr.dz, y, _inverse_guess(cf, pr.dz, y_lo, y_hi, y))
+    return pr.z0 + (lo + t) * pr.dz
 
 
 #: cells :func:`z_of_t_from` walks from its hint's cell before it bisects instead

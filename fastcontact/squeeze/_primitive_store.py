@@ -85,15 +85,21 @@ def write(path, pr, info, model):
     return Path(path)
 
 
-def read(path, expect_key=None):
-    """Read a primitive written by :func:`write`; ValueError if damaged or not the expected."""
+def read_checked(path, what):
+    """(pyarrow table, metadata dict) of a file written with page checksums; ValueError naming
+    ``what`` and the path if it cannot be read."""
     import pyarrow.parquet as pq
 
     try:
         table = pq.read_table(path, page_checksum_verification=True)
-        meta = json.loads(table.schema.metadata[METADATA_KEY])
+        return table, json.loads(table.schema.metadata[METADATA_KEY])
     except Exception as exc:  # noqa: BLE001 - pyarrow raises several types
-        raise ValueError(f"primitive file {str(path)!r} cannot be read ({exc})") from None
+        raise ValueError(f"{what} file {str(path)!r} cannot be read ({exc})") from None
+
+
+def read(path, expect_key=None):
+    """Read a primitive written by :func:`write`; ValueError if damaged or not the expected."""
+    table, meta = read_checked(path, "primitive")
     if meta.get("version") != PRIMITIVE_VERSION or (expect_key and meta.get("key") != expect_key):
         raise ValueError(f"primitive file {str(path)!r} does not belong to these tables")
     nz = int(meta["nz"])

@@ -127,6 +127,7 @@ class SqueezeModel:
         self.tail = tail
         self._prim = None
         self._barus = None
+        self._trap = None
         self._lock = threading.Lock()
         self.setup_seconds = _clock.perf_counter() - t_start
 
@@ -154,6 +155,16 @@ class SqueezeModel:
             if self._prim is None:
                 self._prim = prim.load_or_build(self, cache_dir)
             return self._prim
+
+    def trap_primitive(self):
+        """The trapped side's time primitive (:mod:`._trap_primitive`: cases above the trap
+        pressure by interpolation; built on first use, 0.1-0.4 s on two cores, or read from
+        the primitive cache directory of the tables; its grid in ``trap_primitive_info``)."""
+        with self._lock:
+            if self._trap is None:
+                from . import _trap_store
+                self._trap, self.trap_primitive_info = _trap_store.load_or_build(self)
+            return self._trap
 
     def barus_table(self):
         """(table, info) of the Barus correction beside the primitive (built on first use,

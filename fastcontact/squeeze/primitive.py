@@ -21,7 +21,9 @@ and can be written to / read from Parquet with its grid and its measured interpo
 
 This module gathers the names of its three parts: the record and its evaluation
 (:mod:`._primitive_eval`), the build (:mod:`._primitive_build`) and the on-disk cache
-(:mod:`._primitive_store`).
+(:mod:`._primitive_store`). Above the trap pressure the film drains towards ū_trap instead of
+ū∞; that side has its own primitive of the same form (:mod:`._trap_primitive`), built only
+when a call has trapped cases.
 """
 from __future__ import annotations
 

@@ -1,0 +1,134 @@
+"""Benchmark of the trapped rows of squeeze-out (issue 11.1): error against run time of the
+trapped side's time primitive, against the per-case quadrature measured in the same run.
+
+Writes ``bench/trapped_results.md``. Run: ``python bench/bench_trapped.py [--quick]``.
+
+Cases: p0 log-uniform in ln(p0/E*) - ln π_trap from 2e-4 to the tables' top, per-case starts
+1.3–40 ū_trap, ratio targets 1.5 and 3, a Δu target, ū at one time. Error: max relative
+error of the times to targets above ū_trap and of t_trap against the independent quadrature
+of ``tests/reference/trapped_reference.py`` (panels broken at the tables' nodes). Speed: median
+wall time of repeats (the primitive built before, and its build timed separately on fresh
+tables).
+"""
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "tests"))
+sys.path.insert(0, str(HERE))
+
+from fastcontact._core.vocab import column_name  # noqa: E402
+from fastcontact.squeeze import _trap_primitive as tpm  # noqa: E402
+from fastcontact.squeeze import squeeze_model, squeeze_out  # noqa: E402
+from fastcontact.tables import Tables  # noqa: E402
+from fastcontact.tables.defaults import default_table_path  # noqa: E402
+from machine_info import cpu_model  # noqa: E402
+from reference.trapped_reference import TrappedReference  # noqa: E402
+from results_notes import write_keeping_notes  # noqa: E402
+
+SURFACES = ("asphalt_024mm", "asphalt_072mm")
+THEORIES = ("critical_junction", "emt")
+E, ETA, R = 1e7, 1e-3, 0.01
+
+
+def cases(m, n, seed):
+    rng = np.random.default_rng(seed)
+    x0 = m.x_trap + np.exp(rng.uniform(math.log(2e-4), math.log(m.x_max - m.x_trap), n))
+    vs = m.mp.v_trap * rng.uniform(1.3, 40.0, n)
+    return dict(p0=np.exp(x0) * E, E_star=E, R=rng.uniform(0.005, 0.02, n), eta=ETA,
+                theory=m.theory, u_start=vs * m.h_rms, ratios=(1.5, 3.0),
+                du=(0.3 * m.mp.v_trap * m.h_rms,), times=(1e-3,))
+
+
+def errors(T, m, method, n=10):
+    """Max relative error of the finite times (targets above ū_trap) and of t_trap."""
+    ref = TrappedReference(m)
+    kw = cases(m, n, 11)
+    df = squeeze_out(T, method=method, **kw)
+    h = m.h_rms
+    e_t = e_trap = 0.0
+    for i in range(n):
+        tau = df["tau0"].iloc[i]
+        x0 = math.log(kw["p0"][i] / E)
+        vs = kw["u_start"][i] / h
+        vinf = df["u_inf"].iloc[i] / h
+        for col, vt in (("t_ratio_1.5", 1.5 * vinf), ("t_ratio_3", 3.0 * vinf),
+                        (column_name("t_du", kw["du"][0]), vinf + kw["du"][0] / h)):
+            if m.mp.v_trap < vt < vs:
+                e_t = max(e_t, abs(df[col].iloc[i] / tau / ref.time(x0, vs, vt) - 1.0))
+        e_trap = max(e_trap, abs(df["t_trap"].iloc[i] / tau / ref.t_trap(x0, vs) - 1.0))
+    return e_t, e_trap
+
+
+def rate(T, kw, repeats):
+    squeeze_out(T, **{**kw, "p0": kw["p0"][:64], "R": kw["R"][:64],
+                      "u_start": kw["u_start"][:64]})
+    ts = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        squeeze_out(T, **kw)
+        ts.append(time.perf_counter() - t0)
+    return kw["p0"].size / float(np.median(ts))
+
+
+def build_time(name, theory, repeats):
+    ts = []
+    for _ in range(repeats):
+        m = squeeze_model(Tables.from_parquet(default_table_path(name)), theory)
+        t0 = time.perf_counter()
+        tpm.build(m, check=False)
+        ts.append(time.perf_counter() - t0)
+    tp, info = tpm.build(m, check=True)
+    return float(np.median(ts)), info
+
+
+def main(quick=False):
+    import numba
+
+    n_fast, n_quad, rep = (50_000, 200, 2) if quick else (400_000, 1_000, 5)
+    load0 = os.getloadavg()
+    rows = []
+    for name in SURFACES:
+        T = Tables.from_parquet(default_table_path(name))
+        for th in THEORIES:
+            m = squeeze_model(T, th)
+            m.trap_primitive()
+            kw = cases(m, n_fast, 3)
+            kq = {**kw, "p0": kw["p0"][:n_quad], "R": kw["R"][:n_quad],
+                  "u_start": kw["u_start"][:n_quad], "method": "quad"}
+            f, q = rate(T, kw, rep), rate(T, kq, max(2, rep - 2))
+            ef, eq = errors(T, m, "fast"), errors(T, m, "quad")
+            b, info = build_time(name, th, rep)
+            rows.append((name, th, f, q, ef, eq, b, info))
+    load1 = os.getloadavg()
+    L = ["## Trapped rows of squeeze-out (issue 11.1) — `bench/bench_trapped.py`", "",
+         f"Machine: {cpu_model()}, {os.cpu_count()} cores, numba threads "
+         f"{numba.get_num_threads()}. Load average at start {tuple(round(x, 2) for x in load0)}, "
+         f"at end {tuple(round(x, 2) for x in load1)}.", "",
+         f"Cases: {n_fast:,} (fast) and {n_quad:,} (quad) trapped cases, ln(p0/E*) - ln π_trap "
+         "log-uniform from 2e-4 to the tables' top, per-case starts 1.3–40 ū_trap, targets "
+         "1.5 ū∞, 3 ū∞, ū∞ + 0.3 ū_trap and ū at 1 ms. Errors against the independent "
+         "quadrature of `tests/reference/trapped_reference.py` on 10 cases: times to targets "
+         "above ū_trap, and t_trap.", "",
+         "| tables | theory | fast: cases/s | quad: cases/s | fast / quad | fast: err t | "
+         "fast: err t_trap | quad: err t | quad: err t_trap | build [ms] | rows × z nodes "
+         "(lower + upper) | max rel. err of T at cell centres |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, th, f, q, ef, eq, b, info in rows:
+        L.append(f"| {name} | {th} | {f:.3g} | {q:.3g} | {f / q:.3g} | {ef[0]:.1e} | "
+                 f"{ef[1]:.1e} | {eq[0]:.1e} | {eq[1]:.1e} | {1e3 * b:.0f} | {info['rows']} × "
+                 f"({info['nz_lo']} + {info['nz_hi']}) | {info['max_rel_err_T']:.1e} |")
+    L.append("")
+    write_keeping_notes(HERE / "trapped_results.md", "\n".join(L) + "\n")
+    print("\n".join(L))
+
+
+if __name__ == "__main__":
+    main(quick="--quick" in sys.argv)
