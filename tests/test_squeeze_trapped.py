@@ -187,3 +187,32 @@ def test_stored_with_the_primitive_cache_and_read_back(tmp_path):
         assert a[col].equals(b[col]), col
     with pytest.raises(ValueError, match="does not belong"):
         _trap_store.read(path, expect_key="other")
+
+
+@pytest.mark.parametrize("name", ["asphalt_024mm", "pmma_34um"])
+def test_rows_next_to_the_trap_pressure_cross_the_last_open_node_exactly(name):
+    # non-trapped rows just below the trap pressure (the per-case quadrature's band) whose
+    # film crosses the tables' last open node on its way to ū∞: t* against the independent
+    # quadrature with panels broken at the tables' nodes (before the quadrature broke its own
+    # panels there, 2026-12-03: off by up to 4.5e-3; now ~1e-10)
+    from reference.trapped_reference import _gl_sum
+
+    T = Tables.from_parquet(default_table_path(name))
+    gx, gw = np.polynomial.legendre.leggauss(12)
+    for theory in ("critical_junction", "emt"):
+        m = squeeze_model(T, theory)
+        v_kink = math.exp(float(m.tab.lnu[int(m.tab.n_open) - 1]))
+        for dx in (-0.017, -0.001):
+            x0 = m.x_trap + dx
+            df = squeeze_out(T, p0=math.exp(x0) * E, E_star=E, R=R, eta=ETA, theory=theory)
+            assert df["status"].iloc[0] == "ok"
+            vinf, vs = df["u_inf"].iloc[0] / m.h_rms, df["u_start"].iloc[0] / m.h_rms
+            assert vinf < v_kink < vs  # the film crosses the kink
+            v = np.exp(np.asarray(m.tab.lnu, dtype=np.float64))
+            v = np.sort(np.append(v, m.mp.v_top))
+            br = np.ascontiguousarray(np.log(v[v > vinf * (1 + 1e-12)] - vinf))
+            wa, wb = math.log(0.01 * vinf), math.log(vs - vinf)
+            r1, r2 = (_gl_sum(m.tab, m.mp, x0, vinf, wa, wb, br, w, gx, gw) for w in (0.05, 0.025))
+            assert abs(r1 / r2 - 1.0) < 1e-12
+            got = df["t_star"].iloc[0] / df["tau0"].iloc[0]
+            assert abs(got / r2 - 1.0) < TOL, (theory, dx, got, r2)
