@@ -216,3 +216,18 @@ def test_rows_next_to_the_trap_pressure_cross_the_last_open_node_exactly(name):
             assert abs(r1 / r2 - 1.0) < 1e-12
             got = df["t_star"].iloc[0] / df["tau0"].iloc[0]
             assert abs(got / r2 - 1.0) < TOL, (theory, dx, got, r2)
+
+
+def test_barus_quadrature_next_to_the_trap_pressure_crosses_the_last_open_node_exactly():
+    # the Barus engine's per-case quadrature (rows within 4.4 % below the trap pressure) breaks
+    # its panels at the tables' last open node as the constant-viscosity one does: with a
+    # negligible α (α p0 = 1e-12, a relative change ~1e-12 of the time) its t* agrees with the
+    # constant-viscosity quadrature's, which the test above checks against the reference
+    T = Tables.from_parquet(default_table_path("asphalt_024mm"))
+    for theory in ("critical_junction", "emt"):
+        m = squeeze_model(T, theory)
+        p0 = math.exp(m.x_trap - 0.017) * E
+        base = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, theory=theory, method="quad")
+        bar = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, theory=theory, method="quad",
+                          alpha_pv=1e-12 / p0)
+        assert abs(bar["t_star"].iloc[0] / base["t_star"].iloc[0] - 1.0) < 1e-9

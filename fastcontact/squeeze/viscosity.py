@@ -37,7 +37,8 @@ from .model import squeeze_model
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from ..kernels.readonly import readonly, readonly_fields
-from ._kernels import Cases, Quad, check_computed, new_status, reduced_time, state_gap
+from ._kernels import (Cases, Quad, check_computed, kink_w, new_status, reduced_time,
+                       state_gap)
 from ._kernels import _lnv_of_lnp as qk_lnv_of_lnp
 from ._kernels import _state as qk_state
 
@@ -211,7 +212,19 @@ def _integrand(tab, sc, x0, api, vinf, w):
 
 @njit(cache=True)
 def _segment(tab, sc, x0, api, vinf, w1, w2, quad):
-    """∫_{w1}^{w2} dt̃/dw dw, composite Gauss–Legendre (``quad``), panels of width <= width."""
+    """∫_{w1}^{w2} dt̃/dw dw, composite Gauss–Legendre (``quad``), panels of width <= width,
+    broken at the tables' last open node where it lies inside (:func:`~._kernels.kink_w`: σ̄'s
+    slope jumps there; as the constant-viscosity quadrature)."""
+    wk = kink_w(tab, vinf)
+    if w1 < wk < w2:
+        return (_segment_plain(tab, sc, x0, api, vinf, w1, wk, quad)
+                + _segment_plain(tab, sc, x0, api, vinf, wk, w2, quad))
+    return _segment_plain(tab, sc, x0, api, vinf, w1, w2, quad)
+
+
+@njit(cache=True)
+def _segment_plain(tab, sc, x0, api, vinf, w1, w2, quad):
+    """:func:`_segment` without the break."""
     glx, glw, width = quad.glx, quad.glw, quad.width
     if not (w2 > w1):
         return 0.0
