@@ -231,3 +231,35 @@ def test_barus_quadrature_next_to_the_trap_pressure_crosses_the_last_open_node_e
         bar = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, theory=theory, method="quad",
                           alpha_pv=1e-12 / p0)
         assert abs(bar["t_star"].iloc[0] / base["t_star"].iloc[0] - 1.0) < 1e-9
+
+
+def test_time_continuous_and_monotone_across_the_split():
+    # the two pieces meet at z_split: T from either side agrees there to rounding, so a start
+    # just above it and a target just below give a time >= 0 (and the inverse is monotone)
+    from numba import njit
+
+    T = Tables.from_parquet(default_table_path("asphalt_024mm"))
+    m = squeeze_model(T, "emt")
+    lo, hi, tr = m.trap_primitive()
+    assert tr.z_split > tpm.Z_LO_TRAP  # this table has the kink
+
+    @njit
+    def probe(lo, hi, tr, xs, eps):
+        out = np.empty((xs.size, 4))
+        vb = math.exp(tr.lnvb)
+        for i in range(xs.size):
+            st = tpm.trap_stencil(lo, tr, xs[i])
+            a = tpm.trap_t(lo, hi, tr, st, vb, tr.z_split - eps)
+            b = tpm.trap_t(lo, hi, tr, st, vb, tr.z_split)
+            c = tpm.trap_t(lo, hi, tr, st, vb, tr.z_split + eps)
+            out[i, 0], out[i, 1], out[i, 2] = a, b, c
+            out[i, 3] = tpm.trap_z(lo, hi, tr, st, vb, 0.5 * (a + b))
+        return out
+
+    xs = tr.x_trap + np.exp(np.linspace(math.log(1.1e-4), math.log(tr.x_hi - tr.x_trap) - 1e-9,
+                                        4001))
+    for eps in (1e-12, 1e-9, 1e-6):
+        r = probe(lo, hi, tr, xs, eps)
+        assert np.all(r[:, 0] >= r[:, 1]) and np.all(r[:, 1] >= r[:, 2])
+        assert np.all(np.abs(r[:, 0] / r[:, 1] - 1.0) < 30.0 * eps + 1e-13)  # h/T <= ~20
+        assert np.all((r[:, 3] >= tr.z_split - eps) & (r[:, 3] <= tr.z_split))

@@ -312,18 +312,27 @@ def _lo_t(lo, st, z):
 
 
 @njit(cache=True, inline="always")
+def _lo_offset(lo, hi, st):
+    """What the lower piece adds to its combined T so that both pieces give the same T at
+    z_split: the rows share T there, but the upper piece combines ln T across rows and the
+    lower one T (they differ by the x0 interpolation error, ~1e-7 relative), and a T that
+    rose by that much across z_split would make a time negative."""
+    return math.exp(row_value_2(hi.C, st, 0)) - row_value_2(lo.C, st, lo.nz - 1)
+
+
+@njit(cache=True, inline="always")
 def trap_t(lo, hi, tr, st, vb, z):
     """T(x0, v) at z = ln(v/v_trap - 1) (z = -inf: v_trap itself, the trap floor's T)."""
     if z < tr.z_split:
-        return _lo_t(lo, st, z)
+        return _lo_t(lo, st, z) + _lo_offset(lo, hi, st)
     return t_of_zv(hi, st, vb, z, vb * one_plus_exp(z))
 
 
 @njit(cache=True, inline="always")
-def trap_floor(lo, st):
+def trap_floor(lo, hi, st):
     """T at v_trap: the bottom node's T0 plus the closed form below it, h0."""
     T0, h0 = _lo_bottom(lo, st)
-    return T0 + h0
+    return T0 + h0 + _lo_offset(lo, hi, st)
 
 
 @njit(cache=True)
@@ -331,6 +340,7 @@ def trap_z(lo, hi, tr, st, vb, T):
     """z = ln(v/v_trap - 1) with T(x0, v) = T (-inf at and beyond the trap floor's T)."""
     if T <= math.exp(row_value_2(hi.C, st, 0)):
         return z_of_t_at(hi, st, vb, T, inverse_constants(hi, st))
+    T = T - _lo_offset(lo, hi, st)  # above the lower piece's top node value from here
     T0, h0 = _lo_bottom(lo, st)
     if T >= T0:  # below the grid: T = T0 + h0 (1 - e^(z - z0)), solved in closed form
         r = -(T - T0) / h0
@@ -363,7 +373,7 @@ def trap_row(tab, mp, lo, hi, tr, x0, vs_in, tg, tau, h, i, out):
     out.flf[i] = -math.expm1(tr.x_trap - x0)
     out.t_relax[i] = math.nan
     above = vs > vb
-    T_floor = trap_floor(lo, st)
+    T_floor = trap_floor(lo, hi, st)
     Ts = trap_t(lo, hi, tr, st, vb, zs) if above else T_floor
     if vs == math.inf:
         Ts = 0.0
