@@ -230,11 +230,7 @@ def empty():
     """A :data:`TrapPrimitive` that serves nothing (tables without a trap, engines whose
     trapped rows take the per-case quadrature): the kernels take the same record types
     either way."""
-    sn = np.arange(4.0)
-    C = np.zeros((4, 2, 3))
-    pr = readonly_fields(Primitive(sn, *_index_map(sn), lagrange_denominators(sn), Z_LO_TRAP,
-                                   DZ_TRAP, 2, C, np.zeros(4), np.full(4, -math.inf),
-                                   np.zeros(4), np.zeros(4), math.inf, 0.0, 0.0))
+    pr = piece(np.arange(4.0), Z_LO_TRAP, DZ_TRAP, np.zeros((4, 2, 3)), math.inf, 0.0, 0.0)
     return TrapPrimitive(pr, pr, readonly_fields(TrapRows(math.inf, math.inf,
                                                           -math.inf, 0.0, SPLIT_Z)))
 

@@ -163,7 +163,10 @@ def _trapped_side(model, cs):
     if not math.isfinite(model.x_trap) or cs.p0.size == 0:
         return tpm.empty()
     x_first = model.x_trap + math.exp(tpm.S_MIN)
-    pe = np.max(cs.p0) / cs.E[0] if cs.E.size == 1 else np.max(cs.p0 / cs.E)
+    p_max = np.max(cs.p0)
+    pe = p_max / np.min(cs.E)  # a bound: two reductions, no temporary array per call
+    if pe > 0.0 and math.log(pe) >= x_first and cs.E.size > 1:
+        pe = np.max(cs.p0 / cs.E)  # the exact largest p0/E* only where the bound says maybe
     return model.trap_primitive() if math.log(pe) >= x_first else tpm.empty()
 
 
