@@ -7,8 +7,8 @@ Cases: p0 log-uniform in ln(p0/E*) - ln π_trap from 2e-4 to the tables' top, pe
 1.3–40 ū_trap, ratio targets 1.5 and 3, a Δu target, ū at one time. Error: max relative
 error of the times to targets above ū_trap and of t_trap against the independent quadrature
 of ``tests/reference/trapped_reference.py`` (panels broken at the tables' nodes). Speed: median
-wall time of repeats (the primitive built before, and its build timed separately on fresh
-tables).
+wall time of repeats (the primitive built before, and its build, its build with the error
+check, and the first call of a 1,000-case trapped study on newly read tables timed separately).
 """
 from __future__ import annotations
 
@@ -79,22 +79,73 @@ def rate(T, kw, repeats):
 
 
 def build_time(name, theory, repeats):
-    ts = []
+    """Medians of: the build alone, the build with its error check, and the first call of a
+    1,000-case trapped study on newly read tables (the model's lazy build included)."""
+    tb, tc, tf = [], [], []
     for _ in range(repeats):
         m = squeeze_model(Tables.from_parquet(default_table_path(name)), theory)
         t0 = time.perf_counter()
         tpm.build(m, check=False)
+        t1 = time.perf_counter()
+        tp, info = tpm.build(m, check=True)
+        t2 = time.perf_counter()
+        tb.append(t1 - t0)
+        tc.append(t2 - t1)
+        T = Tables.from_parquet(default_table_path(name))
+        kw = cases(squeeze_model(T, theory), 1_000, 5)
+        t0 = time.perf_counter()
+        squeeze_out(T, **kw)
+        tf.append(time.perf_counter() - t0)
+    return float(np.median(tb)), float(np.median(tc)), float(np.median(tf)), info
+
+
+def history(T, m, n_t, n_quad, repeats):
+    """(points/s of squeeze_history, points/s of the per-case quadrature it replaced, max
+    relative time error of its ū against the forward reference) for one trapped case."""
+    from fastcontact.squeeze import squeeze_history
+    from fastcontact.squeeze._kernels import state_gap
+    from fastcontact.squeeze.api import _cases, _check_method, run_cases
+
+    h, vb = m.h_rms, m.mp.v_trap
+    x0 = m.x_trap + 0.2
+    p0, us = math.exp(x0) * E, 25.0 * vb * h
+    t = np.geomspace(1e-9, 1e3, n_t)
+    squeeze_history(T, p0, E, R, ETA, m.theory, t=t[:64], u_start=us)
+    ts = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        hist = squeeze_history(T, p0, E, R, ETA, m.theory, t=t, u_start=us)
         ts.append(time.perf_counter() - t0)
-    tp, info = tpm.build(m, check=True)
-    return float(np.median(ts)), info
+    # the route it replaced: one case's ū at sorted times by the per-case quadrature
+    quad, _ = _check_method("quad", 16, 0.5, None)
+    cs = _cases(p0, E, R, ETA, us)
+    tq = np.ascontiguousarray(t[:: max(n_t // n_quad, 1)][:, None])
+    tqs = []
+    for _ in range(max(2, repeats - 2)):
+        t0 = time.perf_counter()
+        run_cases(m, cs, np.zeros(0), np.zeros(0), tq, "quad", quad)
+        tqs.append(time.perf_counter() - t0)
+    ref = TrappedReference(m)
+    tau = hist.attrs["tau0"]
+    u = hist["u"].to_numpy() / h
+    err = 0.0
+    for k in np.linspace(0, n_t - 1, 25).astype(int):
+        if u[k] - vb < 1e-8 * vb or u[k] == us / h:
+            continue
+        dt = ref.time(x0, us / h, u[k]) - t[k] / tau
+        sig, d = state_gap(m.tab, m.mp, x0, vb, u[k] - vb)
+        # as a time error, or (where ū is that close to the floor) as ū's distance over ū - ū_trap
+        err = max(err, min(abs(dt) / (t[k] / tau), abs(dt) * sig * d / (u[k] - vb)))
+    return n_t / float(np.median(ts)), tq.shape[0] / float(np.median(tqs)), err
 
 
 def main(quick=False):
     import numba
 
     n_fast, n_quad, rep = (50_000, 200, 2) if quick else (400_000, 1_000, 5)
+    n_hist = 100_000 if quick else 1_000_000
     load0 = os.getloadavg()
-    rows = []
+    rows, hrows = [], []
     for name in SURFACES:
         T = Tables.from_parquet(default_table_path(name))
         for th in THEORIES:
@@ -105,8 +156,9 @@ def main(quick=False):
                   "u_start": kw["u_start"][:n_quad], "method": "quad"}
             f, q = rate(T, kw, rep), rate(T, kq, max(2, rep - 2))
             ef, eq = errors(T, m, "fast"), errors(T, m, "quad")
-            b, info = build_time(name, th, rep)
-            rows.append((name, th, f, q, ef, eq, b, info))
+            b, bc, first, info = build_time(name, th, rep)
+            rows.append((name, th, f, q, ef, eq, b, bc, first, info))
+            hrows.append((name, th) + history(T, m, n_hist, n_quad, rep))
     load1 = os.getloadavg()
     L = ["## Trapped rows of squeeze-out (issue 11.1) — `bench/bench_trapped.py`", "",
          f"Machine: {cpu_model()}, {os.cpu_count()} cores, numba threads "
@@ -118,13 +170,25 @@ def main(quick=False):
          "quadrature of `tests/reference/trapped_reference.py` on 10 cases: times to targets "
          "above ū_trap, and t_trap.", "",
          "| tables | theory | fast: cases/s | quad: cases/s | fast / quad | fast: err t | "
-         "fast: err t_trap | quad: err t | quad: err t_trap | build [ms] | rows × z nodes "
+         "fast: err t_trap | quad: err t | quad: err t_trap | build [ms] | build + error check "
+         "[ms] | first call, 1,000 cases on new tables [ms] | rows × z nodes "
          "(lower + upper) | max rel. err of T at cell centres |",
-         "|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for name, th, f, q, ef, eq, b, info in rows:
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, th, f, q, ef, eq, b, bc, first, info in rows:
         L.append(f"| {name} | {th} | {f:.3g} | {q:.3g} | {f / q:.3g} | {ef[0]:.1e} | "
-                 f"{ef[1]:.1e} | {eq[0]:.1e} | {eq[1]:.1e} | {1e3 * b:.0f} | {info['rows']} × "
+                 f"{ef[1]:.1e} | {eq[0]:.1e} | {eq[1]:.1e} | {1e3 * b:.1f} | {1e3 * bc:.1f} | "
+                 f"{1e3 * first:.1f} | {info['rows']} × "
                  f"({info['nz_lo']} + {info['nz_hi']}) | {info['max_rel_err_T']:.1e} |")
+    L += ["", f"History of one trapped case (ln π0 = ln π_trap + 0.2, start 25 ū_trap): "
+          f"`squeeze_history` at {n_hist:,} times log-uniform in 1e-9–1e3 s, against the route "
+          f"it replaced (per-case quadrature of the same case at {n_quad:,} sorted times, the "
+          "same run). Error: the forward reference's time from the start to each returned ū "
+          "(25 times), relative, or where ū is within reach of ū_trap its distance as a fraction "
+          "of ū - ū_trap.", "",
+          "| tables | theory | history: points/s | quad: points/s | history / quad | "
+          "history: max err |", "|---|---|---|---|---|---|"]
+    for name, th, fh, qh, eh in hrows:
+        L.append(f"| {name} | {th} | {fh:.3g} | {qh:.3g} | {fh / qh:.3g} | {eh:.1e} |")
     L.append("")
     write_keeping_notes(HERE / "trapped_results.md", "\n".join(L) + "\n")
     print("\n".join(L))

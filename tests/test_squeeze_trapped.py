@@ -157,6 +157,26 @@ def test_measured_interpolation_error_below_tolerance():
     assert info["z_split"] > tpm.Z_LO_TRAP and info["max_rel_err_T"] < 1e-6, info
 
 
+@pytest.mark.parametrize("piece_name", ["lo", "hi"])
+def test_measured_error_sees_a_perturbed_table(piece_name):
+    # the check is not the build's own arithmetic echoed back: ln T (upper piece) or T (lower)
+    # moved by 1e-5 relative at one z node of every row shows up at the neighbouring cell
+    # centres (the quintic's weight of a node value there is 1/2: ~5e-6)
+    T = Tables.from_parquet(default_table_path("pmma_34um"))
+    m = squeeze_model(T, "critical_junction")
+    tp, _ = tpm.build(m, check=False)
+    pr = getattr(tp, piece_name)
+    C = pr.C.copy()
+    k = C.shape[1] // 2
+    if piece_name == "hi":
+        C[:, k, 0] += 1e-5
+    else:
+        C[:, k, 0] *= 1.0 + 1e-5
+    bad = tp._replace(**{piece_name: tpm.piece(pr.xn, pr.z0, pr.dz, C, pr.v_ext, pr.c, pr.d)})
+    err = tpm.measure_error(m, bad)["max_rel_err_T"]
+    assert 2e-6 < err < 2e-5, err
+
+
 def test_stored_with_the_primitive_cache_and_read_back(tmp_path):
     from fastcontact.squeeze import _trap_store, set_primitive_cache
 
@@ -263,3 +283,44 @@ def test_time_continuous_and_monotone_across_the_split():
         assert np.all(r[:, 0] >= r[:, 1]) and np.all(r[:, 1] >= r[:, 2])
         assert np.all(np.abs(r[:, 0] / r[:, 1] - 1.0) < 30.0 * eps + 1e-13)  # h/T <= ~20
         assert np.all((r[:, 3] >= tr.z_split - eps) & (r[:, 3] <= tr.z_split))
+
+
+@pytest.mark.parametrize("theory", ["critical_junction", "emt"])
+def test_history_of_a_trapped_case_from_the_primitive(theory):
+    # squeeze_history of a case above the trap pressure: served by the trapped side's primitive
+    # (it was the per-case quadrature, one forward integration per call); ū at each time
+    # against the independent reference (the forward time from the start to the returned ū),
+    # and equal to squeeze_out's ū at the same times
+    from fastcontact.squeeze import squeeze_history
+
+    T = Tables.from_parquet(default_table_path("asphalt_024mm"))
+    m = squeeze_model(T, theory)
+    ref = TrappedReference(m)
+    h, vb = m.h_rms, m.mp.v_trap
+    x0 = m.x_trap + 0.2
+    vs = 25.0 * vb
+    p0 = math.exp(x0) * E
+    t = np.concatenate([[0.0, math.inf], np.geomspace(1e-9, 1e3, 40)])[::-1]  # any order
+    hist = squeeze_history(T, p0, E, R, ETA, theory, t=t, u_start=vs * h)
+    assert hist.attrs["trapped"] and m._trap is not None
+    tau = hist.attrs["tau0"]
+    u = hist["u"].to_numpy() / h
+    assert u[t == 0.0][0] == vs and u[t == math.inf][0] == vb
+    df = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, theory=theory, u_start=vs * h,
+                     ratios=(), times=tuple(t))
+    np.testing.assert_array_equal(hist["u"].to_numpy(),
+                                  [df[column_name("u_at", tk)].iloc[0] for tk in t])
+    served = 0
+    for tk, uk in zip(t, u):
+        if not (0.0 < tk < math.inf) or uk - vb < 1e-8 * vb or uk == vs:
+            continue
+        t_red = tk / tau
+        dt = ref.time(x0, vs, uk) - t_red
+        sig, d = qk.state_gap(m.tab, m.mp, x0, vb, uk - vb)
+        assert (abs(dt) < TOL * t_red
+                or abs(dt) * sig * d < max(TOL * (uk - vb), 1e-8 * vb)), (tk, uk, dt)
+        served += 1
+    assert served >= 10
+    # ū falls with t towards ū_trap
+    order = np.argsort(t)
+    assert np.all(np.diff(u[order]) <= 0.0)

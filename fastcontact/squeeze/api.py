@@ -15,6 +15,7 @@ from .._core.validate import align_inputs, as_float_array, check_positive
 from .._core.vocab import DEFAULT_THEORY, REFERENCES, column_name
 from ..tables import Tables
 from . import _kernels as qk
+from . import _trap_primitive as tpm
 from ._fastpath import fast_kernel, history_kernel, one_case_primitive, quad_kernel, row_targets
 from .model import DEFAULT_P_START, squeeze_model
 from .primitive import fast_limit
@@ -158,8 +159,6 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad, timescales=True):
 def _trapped_side(model, cs):
     """The trapped side's primitive of ``model`` if a case of ``cs`` lies where it serves
     (built then, on first use), else the empty one: a study that never traps builds none."""
-    from . import _trap_primitive as tpm
-
     if not math.isfinite(model.x_trap) or cs.p0.size == 0:
         return tpm.empty()
     x_first = model.x_trap + math.exp(tpm.S_MIN)
@@ -278,7 +277,7 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=No
     towards ū_trap, the separation where σ̄ collapses to the trap floor ``sigma_trap``
     (default the tables' ``sigma_floor``, 1e-24), not towards ū∞. With ``method="fast"``
     their times and ū at times come from a second time primitive of the trapped side, built
-    on first need (0.1–0.4 s; a study without trapped cases builds none), at 1e6 cases/s;
+    on first need (~10 ms; a study without trapped cases builds none), at 1e6 cases/s;
     cases less than 1e-4 above the trap pressure in ln(p0/E*), and non-trapped ones within
     4.4 % below it, take the per-case quadrature. The same 1e-6 bounds hold (measured ≤ 7e-7
     for times to targets above ū_trap, against a quadrature with panels broken at the
@@ -366,7 +365,10 @@ def squeeze_history(tables, p0, E_star, R, eta, theory=DEFAULT_THEORY, t=None, u
     t : array_like
         Times [s] ≥ 0 (+inf allowed), any order.
     quad_order, quad_width
-        Quadrature of the fall-back (trapped) case.
+        Quadrature of the fall-back cases: p0 within 4.4 % below the trap pressure, or less
+        than 1e-4 above it in ln(p0/E*). Other cases come from a time primitive: the
+        equilibrium side's, or for a trapped case (p0 above the trap pressure) the trapped
+        side's (ū at each time within the 1e-6 of :func:`squeeze_out`'s ū at a time).
 
     Returns
     -------
@@ -395,9 +397,13 @@ def squeeze_history(tables, p0, E_star, R, eta, theory=DEFAULT_THEORY, t=None, u
     h = model.h_rms
     x0 = math.log(float(p0) / float(E_star))
     u = np.empty(t.size)
+    vs = math.nan if u_start is None else float(u_start) / h
+    tp = model.trap_primitive() if row["status"] == "trapped" else None
     if row["status"] == "ok" and x0 <= fast_limit(model):
-        vs = math.nan if u_start is None else float(u_start) / h
         history_kernel(*one_case_primitive(model.primitive(), x0), vs, float(row["tau0"]), h, t, u)
+    elif tp is not None and tp.rows.x_lo <= x0 <= tp.rows.x_hi:
+        tpm.trap_history_kernel(model.tab, model.mp, tp.lo, tp.hi, tp.rows, x0, vs,
+                                float(row["tau0"]), h, t, u)
     else:
         order = np.argsort(t, kind="stable")
         quad, _ = _check_method("quad", quad_order, quad_width, sigma_trap)

@@ -158,8 +158,9 @@ class SqueezeModel:
 
     def trap_primitive(self):
         """The trapped side's time primitive (:mod:`._trap_primitive`: cases above the trap
-        pressure by interpolation; built on first use, 0.1-0.4 s on two cores, or read from
-        the primitive cache directory of the tables; its grid in ``trap_primitive_info``)."""
+        pressure by interpolation; built on first use, ~10 ms on two cores with its error
+        measured, or read from the primitive cache directory of the tables; its grid and
+        measured error in ``trap_primitive_info``)."""
         with self._lock:
             if self._trap is None:
                 from . import _trap_store
