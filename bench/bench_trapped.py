@@ -3,7 +3,7 @@ trapped side's time primitive, against the per-case quadrature measured in the s
 
 Writes ``bench/trapped_results.md``. Run: ``python bench/bench_trapped.py [--quick]``.
 
-Cases: p0 log-uniform in ln(p0/E*) - ln π_trap from 2e-4 to the tables' top, per-case starts
+Cases: p0 log-uniform in ln(p0/E*) - ln π_trap from 2e-8 to the tables' top, per-case starts
 1.3–40 ū_trap, ratio targets 1.5 and 3, a Δu target, ū at one time. Error: max relative
 error of the times to targets above ū_trap and of t_trap against the independent quadrature
 of ``tests/reference/trapped_reference.py`` (panels broken at the tables' nodes). Speed: median
@@ -40,7 +40,7 @@ E, ETA, R = 1e7, 1e-3, 0.01
 
 def cases(m, n, seed):
     rng = np.random.default_rng(seed)
-    x0 = m.x_trap + np.exp(rng.uniform(math.log(2e-4), math.log(m.x_max - m.x_trap), n))
+    x0 = m.x_trap + np.exp(rng.uniform(math.log(2e-8), math.log(m.x_max - m.x_trap), n))
     vs = m.mp.v_trap * rng.uniform(1.3, 40.0, n)
     return dict(p0=np.exp(x0) * E, E_star=E, R=rng.uniform(0.005, 0.02, n), eta=ETA,
                 theory=m.theory, u_start=vs * m.h_rms, ratios=(1.5, 3.0),
@@ -165,7 +165,7 @@ def main(quick=False):
          f"{numba.get_num_threads()}. Load average at start {tuple(round(x, 2) for x in load0)}, "
          f"at end {tuple(round(x, 2) for x in load1)}.", "",
          f"Cases: {n_fast:,} (fast) and {n_quad:,} (quad) trapped cases, ln(p0/E*) - ln π_trap "
-         "log-uniform from 2e-4 to the tables' top, per-case starts 1.3–40 ū_trap, targets "
+         "log-uniform from 2e-8 to the tables' top, per-case starts 1.3–40 ū_trap, targets "
          "1.5 ū∞, 3 ū∞, ū∞ + 0.3 ū_trap and ū at 1 ms. Errors against the independent "
          "quadrature of `tests/reference/trapped_reference.py` on 10 cases: times to targets "
          "above ū_trap, and t_trap.", "",

@@ -43,7 +43,7 @@ def test_trapped_rows_against_independent_quadrature(tables, theory):
     h = m.h_rms
     rng = np.random.default_rng(7)
     n = 12
-    x0 = m.x_trap + np.exp(rng.uniform(math.log(2e-4), math.log(m.x_max - m.x_trap), n))
+    x0 = m.x_trap + np.exp(rng.uniform(math.log(2e-8), math.log(m.x_max - m.x_trap), n))
     vs = m.mp.v_trap * rng.uniform(1.3, 40.0, n)
     dv = 0.3 * m.mp.v_trap
     times = np.array([1e-7, 1e-5, 1e-3, 1e-1, 10.0])
@@ -276,7 +276,7 @@ def test_time_continuous_and_monotone_across_the_split():
             out[i, 3] = tpm.trap_z(lo, hi, tr, st, vb, 0.5 * (a + b))
         return out
 
-    xs = tr.x_trap + np.exp(np.linspace(math.log(1.1e-4), math.log(tr.x_hi - tr.x_trap) - 1e-9,
+    xs = tr.x_trap + np.exp(np.linspace(math.log(1.1e-8), math.log(tr.x_hi - tr.x_trap) - 1e-9,
                                         4001))
     for eps in (1e-12, 1e-9, 1e-6):
         r = probe(lo, hi, tr, xs, eps)

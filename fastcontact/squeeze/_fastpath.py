@@ -4,7 +4,7 @@ Every output is a few interpolations of the primitive T(x0, ū) per case
 (:mod:`fastcontact.squeeze.primitive`): t(a → b) = τ0 [T(b) - T(a)], ū(t) from
 T(ū) = T(ū_start) + t/τ0. Trapped rows (p0 above the trap pressure) come from the trapped
 side's primitive (:mod:`._trap_primitive`); the rows neither serves (p0 within 4.4 % below the
-trap pressure or less than 1e-4 above it in ln p0, outside the tables) fall back to the
+trap pressure or less than 1e-8 above it in ln p0, outside the tables) fall back to the
 per-case quadrature in the same pass.
 """
 from __future__ import annotations

@@ -75,8 +75,11 @@ TrapPrimitive = namedtuple("TrapPrimitive", "lo hi rows")
 TrapRows = namedtuple("TrapRows", "x_trap x_lo x_hi lnvb z_split")
 
 #: s = ln(x0 - x_trap) of the first row: rows from x0 = x_trap + e^S_MIN (cases between the
-#: trap pressure and it take the per-case quadrature)
-S_MIN = math.log(1e-4)
+#: trap pressure and it take the per-case quadrature). 1e-8: p0 within 1e-6 % of the trap
+#: pressure; closer, x0 - x_trap itself carries the rounding of x0 (~1e-16 |x0|) at more
+#: than 1e-8 relative (times 1e-8 off the reference at 1.2e-8: 2.6e-9; until 2026-12-04 the
+#: rows began at 1e-4, when the build cost ~50x more a row)
+S_MIN = math.log(1e-8)
 #: spacing of the rows in s
 DS = 0.05
 #: bottom of the z grid and the largest spacing of the two pieces (each piece's spacing

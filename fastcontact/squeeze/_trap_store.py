@@ -22,8 +22,9 @@ from ._primitive_store import _CACHE_ATTR, read_checked
 
 __all__ = ["load_or_build", "write", "read", "trap_path", "TRAP_VERSION"]
 
-#: format version of the stored trapped-side primitives (another version is rebuilt)
-TRAP_VERSION = 1
+#: format version of the stored trapped-side primitives (another version is rebuilt; 2: rows
+#: from 1e-8 above the trap pressure in ln p0, were from 1e-4)
+TRAP_VERSION = 2
 _PIECES = (("lo", ("T", "dT", "d2T")), ("hi", ("L", "D1", "D2")))
 
 

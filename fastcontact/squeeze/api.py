@@ -278,7 +278,7 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=No
     (default the tables' ``sigma_floor``, 1e-24), not towards ū∞. With ``method="fast"``
     their times and ū at times come from a second time primitive of the trapped side, built
     on first need (~10 ms; a study without trapped cases builds none), at 1e6 cases/s;
-    cases less than 1e-4 above the trap pressure in ln(p0/E*), and non-trapped ones within
+    cases less than 1e-8 above the trap pressure in ln(p0/E*), and non-trapped ones within
     4.4 % below it, take the per-case quadrature. The same 1e-6 bounds hold (measured ≤ 7e-7
     for times to targets above ū_trap, against a quadrature with panels broken at the
     tables' nodes). ``t_trap`` is the time to reach ū_trap; it scales as 1/sigma_trap:
@@ -366,7 +366,7 @@ def squeeze_history(tables, p0, E_star, R, eta, theory=DEFAULT_THEORY, t=None, u
         Times [s] ≥ 0 (+inf allowed), any order.
     quad_order, quad_width
         Quadrature of the fall-back cases: p0 within 4.4 % below the trap pressure, or less
-        than 1e-4 above it in ln(p0/E*). Other cases come from a time primitive: the
+        than 1e-8 above it in ln(p0/E*). Other cases come from a time primitive: the
         equilibrium side's, or for a trapped case (p0 above the trap pressure) the trapped
         side's (ū at each time within the 1e-6 of :func:`squeeze_out`'s ū at a time).
 
