@@ -324,3 +324,31 @@ def test_history_of_a_trapped_case_from_the_primitive(theory):
     # ū falls with t towards ū_trap
     order = np.argsort(t)
     assert np.all(np.diff(u[order]) <= 0.0)
+
+
+def test_study_of_trapped_cases_only_builds_no_equilibrium_primitive():
+    # every case above the equilibrium side's range (trapped, or next to the trap pressure):
+    # the call builds only what it uses, and its rows are those of a call that had the
+    # equilibrium side's primitive built (bit for bit: neither reads it)
+    T = Tables.from_parquet(default_table_path("pmma_34um"))
+    m = squeeze_model(T, "emt")
+    m._prim = None
+    x0 = m.x_trap + np.array([-0.01, 1e-9, 1e-3, 0.3])  # the band, the quadrature, trapped
+    kw = dict(p0=np.exp(x0) * E, E_star=E, R=R, eta=ETA, theory="emt", times=(1e-3, 1.0))
+    a = squeeze_out(T, **kw)
+    assert m._prim is None and m._trap is not None
+    assert list(a["status"]) == ["ok", "trapped", "trapped", "trapped"]
+    tire = tire_footprint(T, p0=kw["p0"], E_star=E, R=R, eta=ETA, theory="emt", speed=20.0,
+                          footprint_length=0.1, method="fast")
+    assert m._prim is None
+    m.primitive()
+    b = squeeze_out(T, **kw)
+    tire_b = tire_footprint(T, p0=kw["p0"], E_star=E, R=R, eta=ETA, theory="emt", speed=20.0,
+                            footprint_length=0.1, method="fast")
+    for x, y in ((a, b), (tire, tire_b)):
+        for col in x.columns:
+            assert x[col].equals(y[col]), col
+    # one case inside the equilibrium side's range: built
+    m._prim = None
+    squeeze_out(T, **{**kw, "p0": np.exp(np.append(x0, m.x_trap - 1.0)) * E})
+    assert m._prim is not None

@@ -142,18 +142,31 @@ def run_cases(model, cs, ratios, dvs, times2d, method, quad, timescales=True):
     if method == "quad":
         quad_kernel(model.tab, model.mp, cs, model.h_rms, tg, quad, out)
     else:
-        pr = model.primitive()
+        pr, x_fast = _equilibrium_side(model, cs)
         us = cs.us
         # one start for all (NaN: never equal; a size-1 start is shared by every case)
         shared = n > 1 and (us.size == 1 or us.min() == us.max())
         rt = row_targets(pr, tg.ratios, tg.dvs, us[0] / model.h_rms if shared else math.nan)
         tp = _trapped_side(model, cs)
-        fast_kernel(model.tab, model.mp, pr, rt, fast_limit(model), tp.lo, tp.hi, tp.rows, cs,
+        fast_kernel(model.tab, model.mp, pr, rt, x_fast, tp.lo, tp.hi, tp.rows, cs,
                     model.h_rms, tg, quad, out, bool(timescales))
     qk.check_computed(out.status, "squeeze_out")
     if not timescales:  # not written on the rows the fast path serves: nothing to read
         out = out._replace(t_relax=None, t_trap=None, tau0=None)
     return out
+
+
+def _equilibrium_side(model, cs):
+    """(primitive, x_fast): the time primitive of ``model`` and the largest ln(p0/E*) it serves,
+    or, where every case of ``cs`` lies above that (trapped, or next to the trap pressure),
+    an empty record of the same type that serves none (x_fast = -inf): such a study builds
+    no primitive it would not use."""
+    x_fast = fast_limit(model)
+    if cs.p0.size > 0:
+        lo = np.min(cs.p0) / np.max(cs.E)  # a bound below every case's p0/E*: two reductions
+        if lo > 0.0 and math.log(lo) > x_fast:
+            return tpm.empty().lo, -math.inf
+    return model.primitive(), x_fast
 
 
 def _trapped_side(model, cs):
