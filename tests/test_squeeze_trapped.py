@@ -352,3 +352,57 @@ def test_study_of_trapped_cases_only_builds_no_equilibrium_primitive():
     m._prim = None
     squeeze_out(T, **{**kw, "p0": np.exp(np.append(x0, m.x_trap - 1.0)) * E})
     assert m._prim is not None
+
+
+@pytest.mark.parametrize("name", ["asphalt_072mm", "copper_012mm"])
+def test_quadrature_of_trapped_rows_within_tolerance(name):
+    # method="quad" (and the fast path's fall-back rows) on the trapped side with its default
+    # panels: times to targets just above ū_trap against the independent reference. With unit
+    # panels in ln(ū - ū_trap) these were up to 3.8e-6 off on these two tables (their last open
+    # node lies below the trap pressure); a trapped row's panels are now a third of the width
+    T = Tables.from_parquet(default_table_path(name))
+    m = squeeze_model(T, "critical_junction")
+    ref = TrappedReference(m)
+    h, vb = m.h_rms, m.mp.v_trap
+    x0 = m.x_trap + np.array([1.7e-4, 1.85e-4, 2.2e-4, 4.1e-4, 5.2e-4])
+    vs = vb * np.array([30.0, 7.1, 3.7, 1.3, 89.0])
+    df = squeeze_out(T, p0=np.exp(x0) * E, E_star=E, R=R, eta=ETA, theory="critical_junction",
+                     u_start=vs * h, ratios=(1.5,), method="quad")
+    assert (df["status"] == "trapped").all()
+    checked = 0
+    for i in range(x0.size):
+        tau, vinf = df["tau0"].iloc[i], df["u_inf"].iloc[i] / h
+        for col, r in (("t_star", 1.01), ("t_ratio_1.5", 1.5)):
+            vt = r * vinf
+            if vb < vt < vs[i]:
+                got = df[col].iloc[i] / tau
+                assert abs(got / ref.time(x0[i], vs[i], vt) - 1.0) < TOL, (col, x0[i], vs[i])
+                checked += 1
+    assert checked >= 5
+
+
+@pytest.mark.parametrize("name", ["asphalt_072mm", "asphalt_024mm"])
+def test_barus_trapped_rows_against_the_reynolds_reference(name):
+    # a Barus oil (α = 1e-8 1/Pa) on trapped rows: times to targets just above ū_trap against
+    # the independent Reynolds solution with η(p) (tests/reference/ext_reynolds.py, its
+    # w-origin at ū_trap), and ū_trap at t = inf. The Barus engine integrated these rows in
+    # ln(ū - ū∞), unresolved where σ̄ collapses at ū_trap: up to 17 % off (2026-12-04)
+    from reference.ext_reynolds import squeeze_time
+
+    T = Tables.from_parquet(default_table_path(name))
+    m = squeeze_model(T, "critical_junction")
+    h, vb, alpha = m.h_rms, m.mp.v_trap, 1e-8
+    x0 = m.x_trap + np.array([2e-4, 0.05])
+    p0 = np.exp(x0) * E
+    vs = 5.0 * vb
+    for i in range(x0.size):
+        vinf = math.exp(qk._lnv_of_lnp(m.tab, m.mp, x0[i]))
+        r = 1.05 * vb / vinf
+        df = squeeze_out(T, p0=p0[i], E_star=E, R=R, eta=ETA, theory="critical_junction",
+                         u_start=vs * h, ratios=(r,), times=(math.inf,), alpha_pv=alpha)
+        assert df["status"].iloc[0] == "trapped"
+        assert df[column_name("u_at", math.inf)].iloc[0] == pytest.approx(vb * h, rel=1e-12)
+        got = df[column_name("t_ratio", r)].iloc[0]
+        ref = squeeze_time(T, "critical_junction", p0[i], E, R, ETA, alpha, vs * h,
+                           1.05 * vb * h, vb * h)
+        assert abs(got / ref - 1.0) < TOL, (x0[i] - m.x_trap, got, ref)

@@ -442,6 +442,16 @@ def _case_times(tab, mp, film, tg, h, quad, i, out):
             out.U[k, i] = v * h
 
 
+#: panel width of a trapped row's quadrature, in units of the quadrature's ``width``: its
+#: integrand 1/(σ̄ (1 - π_c/π0)) rises towards v_trap as σ̄ collapses, and with the default
+#: 10 points on unit panels in ln(v - v_trap) the times to targets just above ū_trap were up
+#: to 3.8e-6 off the independent reference on tables whose last open node lies below the trap
+#: pressure (asphalt_072mm, copper_012mm; 2026-12-04); half the width: ≤ 5.2e-7, a third
+#: ≤ 1.5e-7 (1,000 random trapped cases per table and theory; 3x the evaluations of these
+#: rows, which the fast path serves from its trapped-side primitive)
+TRAPPED_WIDTH = 1.0 / 3.0
+
+
 @njit(cache=True)
 def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
     """Everything for one case by quadrature, written in SI to column i of ``out``."""
@@ -457,6 +467,8 @@ def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
         out.u_inf[i] = film.vinf * h
         out.status[i] = ST_BELOW
         return
+    if film.trapped:  # half the panel width on the trapped side (TRAPPED_WIDTH)
+        quad = Quad(quad.glx, quad.glw, TRAPPED_WIDTH * quad.width)
     _case_targets(tab, mp, film, tg, quad, i, out)
     _case_times(tab, mp, film, tg, h, quad, i, out)
     # last: a worker thread that fails above stops without raising, and the row must keep

@@ -258,7 +258,8 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=No
         Time primitive (default) or per-case Gauss–Legendre quadrature.
     quad_order, quad_width : int, float
         Gauss–Legendre order and panel width in ln(ū - ū∞) of the quadrature (``"quad"`` and
-        the fall-back rows of ``"fast"``).
+        the fall-back rows of ``"fast"``; on trapped rows in ln(ū - ū_trap), panels a third
+        of the width).
     sigma_trap : float or None
         Conductivity floor of the trap criterion [-] (default: the tables' ``sigma_floor``).
     **extensions
@@ -292,9 +293,10 @@ def squeeze_out(tables, *, p0, E_star, R, eta, theory=DEFAULT_THEORY, u_start=No
     their times and ū at times come from a second time primitive of the trapped side, built
     on first need (~10 ms; a study without trapped cases builds none), at 1e6 cases/s;
     cases less than 1e-8 above the trap pressure in ln(p0/E*), and non-trapped ones within
-    4.4 % below it, take the per-case quadrature. The same 1e-6 bounds hold (measured ≤ 7e-7
-    for times to targets above ū_trap, against a quadrature with panels broken at the
-    tables' nodes). ``t_trap`` is the time to reach ū_trap; it scales as 1/sigma_trap:
+    4.4 % below it, take the per-case quadrature. The same 1e-6 bounds hold (measured ≤ 1e-7
+    for times to targets above ū_trap, fast and quad, against a quadrature with panels
+    broken at the tables' nodes; before 2026-12-04 the quadrature's unit panels missed them
+    by up to 3.8e-6 on tables whose last open node lies below the trap pressure). ``t_trap`` is the time to reach ū_trap; it scales as 1/sigma_trap:
     3e19–1e22 τ0 on the four embedded surfaces (critical junction and EMT, ln π0 0.02–0.7
     above ln π_trap) — read it as "never drains", not as a drainage time. Within 1e-6 of a
     converged quadrature (measured ≤ 7e-8 fast, ≤ 7e-9 quad; before 2026-12-03 the

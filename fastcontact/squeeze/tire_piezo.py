@@ -32,8 +32,8 @@ from ..kernels.readonly import readonly, readonly_fields
 from ._kernels import Cases, Quad, check_computed, new_status, reduced_time
 from .api import STATUS_NAMES
 from .viscosity import (BarusTargets, _case_head, _case_start, _lnv_of_lnp, _scalars,
-                        _state, _target_times, exit_w, fast_scratch, fast_setup,
-                        flag_overflow)
+                        _state, _target_times, fast_scratch, fast_setup, flag_overflow,
+                        trap_floor_v, v_at_time)
 
 __all__ = ["QUAD_ORDER", "QUAD_WIDTH", "STATUS", "barus_tire_columns"]
 
@@ -87,12 +87,10 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
         return
     _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
     if t_fp.size:  # no footprint times: the exit is not asked for
-        tt = reduced_time(t_fp[i], tau)
-        if tt == math.inf:  # τ0 = 0 (a row flagged "overflow" afterwards): ū∞
-            out.u_exit[i] = vinf * h
-        else:
-            w = exit_w(tab, sc, x0, api, vinf, math.log(vs - vinf), tt, quad)
-            out.u_exit[i] = (vinf + math.exp(w)) * h
+        # tt = inf (τ0 = 0, a row flagged "overflow" afterwards): ū∞, or ū_trap if trapped
+        out.u_exit[i] = v_at_time(tab, sc, x0, api, vinf,
+                                  trap_floor_v(tab, sc, x0), vs, reduced_time(t_fp[i], tau),
+                                  quad) * h
     # last (a failing worker thread stops without raising: the row keeps NOT_COMPUTED)
     out.status[i] = _TRAPPED if trapped else _OK
 

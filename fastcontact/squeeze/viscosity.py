@@ -37,8 +37,8 @@ from .model import squeeze_model
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from ..kernels.readonly import readonly, readonly_fields
-from ._kernels import (Cases, Quad, check_computed, kink_w, new_status, reduced_time,
-                       state_gap)
+from ._kernels import (TRAPPED_WIDTH, Cases, Quad, check_computed, kink_w, new_status,
+                       reduced_time, state_gap)
 from ._kernels import _lnv_of_lnp as qk_lnv_of_lnp
 from ._kernels import _state as qk_state
 
@@ -239,10 +239,77 @@ def _segment_plain(tab, sc, x0, api, vinf, w1, w2, quad):
 
 
 @njit(cache=True)
+def trap_floor_v(tab, sc, x0):
+    """v_trap, the separation where π_c reaches the trap pressure (σ̄ = 0 at and below it), for
+    a trapped row (x0 >= x_trap); NaN otherwise."""
+    x_trap = sc[0].x_trap
+    return math.exp(_lnv_of_lnp(tab, sc, x_trap)) if x0 >= x_trap else math.nan
+
+
+@njit(cache=True, inline="always")
+def _trapped_quad(quad):
+    """The quadrature of a trapped row: panels of TRAPPED_WIDTH times the width (in
+    w = ln(v - v_trap); as the constant-viscosity engine's trapped rows)."""
+    return Quad(quad.glx, quad.glw, TRAPPED_WIDTH * quad.width)
+
+
+@njit(cache=True)
+def _trapped_target_times(tab, sc, x0, api, vinf, vb, vs, tau, tg, quad, T, i):
+    """:func:`_target_times` of a trapped row (floor vb = v_trap): w = ln(v - v_trap), where
+    the integrand stays finite down to v_trap (in ln(v - v∞) the panels ran into σ̄ = 0 at
+    v_trap unresolved: times to targets just above ū_trap were up to 17 % off, 2026-12-04);
+    targets at or below v_trap, or every target of a start at or below it, never reached
+    (inf), targets at or above the start 0."""
+    vt_ratio = tg.ratios
+    nt = T.shape[0]
+    nr = vt_ratio.size
+    q = _trapped_quad(quad)
+    wts = np.empty(nt)
+    vts = np.empty(nt)
+    for k in range(nt):
+        vts[k] = vt_ratio[k] * vinf if k < nr else vinf + tg.dvs[k - nr]
+        wts[k] = math.log(vts[k] - vb) if vts[k] > vb else -math.inf
+    order = np.argsort(-wts)
+    w_cur = math.log(vs - vb) if vs > vb else -math.inf
+    t_cur = 0.0
+    for kk in range(nt):
+        k = order[kk]
+        if vts[k] >= vs:
+            T[k, i] = 0.0
+            continue
+        if not (vts[k] > vb and vs > vb):
+            T[k, i] = math.inf
+            continue
+        if wts[k] < w_cur:
+            t_cur += _segment(tab, sc, x0, api, vb, wts[k], w_cur, q)
+            w_cur = wts[k]
+        T[k, i] = tau * t_cur
+
+
+@njit(cache=True)
+def v_at_time(tab, sc, x0, api, vinf, vb, vs, tt, quad):
+    """v at the reduced time tt from the start vs (vb = v_trap on a trapped row, else NaN): the
+    start at tt = 0 or where it lies at or below v_trap; ū∞ (v_trap on a trapped row) at
+    tt = inf; else :func:`exit_w` on w = ln(v - v∞), or ln(v - v_trap) on a trapped row."""
+    trapped = vb == vb
+    if tt == 0.0 or (trapped and not (vs > vb)):
+        return vs
+    vr = vb if trapped else vinf
+    if tt == math.inf:
+        return vr
+    q = _trapped_quad(quad) if trapped else quad
+    return vr + math.exp(exit_w(tab, sc, x0, api, vr, math.log(vs - vr), tt, q))
+
+
+@njit(cache=True)
 def _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i):
     """Times [s] from v_start down to each target of ``tg`` (:data:`BarusTargets`) into
     column i of T: one downward pass over the targets in descending order; 0 for targets
-    passed."""
+    passed (a trapped row: :func:`_trapped_target_times`)."""
+    vb = trap_floor_v(tab, sc, x0)
+    if vb == vb:
+        _trapped_target_times(tab, sc, x0, api, vinf, vb, vs, tau, tg, quad, T, i)
+        return
     vt_ratio = tg.ratios
     vt_dv = tg.dvs
     nt = T.shape[0]
@@ -345,15 +412,11 @@ def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
         _no_times(out, i, np.int64(ST_PIEZO))
         return
     _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, out.T, i)
-    w0 = math.log(vs - vinf)
+    vb = trap_floor_v(tab, sc, x0)
     for k in range(tg.times.size):
-        tt = reduced_time(tg.times[k], tau)
-        if tt == 0.0:
-            out.U[k, i] = vs * h
-        elif tt == math.inf:  # ū∞ (as the base engine; no walk of W_SPAN panels)
-            out.U[k, i] = vinf * h
-        else:
-            out.U[k, i] = (vinf + math.exp(exit_w(tab, sc, x0, api, vinf, w0, tt, quad))) * h
+        # inf: ū∞, or ū_trap on a trapped row (as the base engine; no walk of W_SPAN panels)
+        out.U[k, i] = v_at_time(tab, sc, x0, api, vinf, vb, vs, reduced_time(tg.times[k], tau),
+                                quad) * h
     # last (a failing worker thread stops without raising: the row keeps NOT_COMPUTED)
     out.status[i] = ST_TRAPPED if x0 >= sc[0].x_trap else ST_OK
 
@@ -461,7 +524,9 @@ def squeeze_out_piezo(tables, *, p0, E_star, R, eta, alpha_pv, theory=DEFAULT_TH
         the trap pressure or beyond, outside the tables) take the per-case quadrature in the
         same pass. "quad": the per-case quadrature for every row.
     quad_order, quad_width :
-        Gauss–Legendre order and panel width in w = ln(ū - ū∞) [-] of the quadrature.
+        Gauss–Legendre order and panel width in w = ln(ū - ū∞) [-] of the quadrature (on a
+        trapped row w = ln(ū - ū_trap), where the integrand stays finite down to ū_trap, and
+        a third of the width: within 1e-6 of the Reynolds reference).
     sigma_trap : float, optional
         Reduced conductivity below which σ is treated as 0 (default the tables' floor).
 
