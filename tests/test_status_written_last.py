@@ -83,7 +83,8 @@ def test_base_quadrature_row_failing_after_its_state_is_not_returned(tables, mon
 
 
 def test_barus_quadrature_row_failing_in_its_time_loop_is_not_returned(tables, monkeypatch):
-    monkeypatch.setattr(viscosity, "exit_w", _FailOnce(viscosity.exit_w, 2))
+    # the step that gives ū at each time (it walks exit_w): one call per row here
+    monkeypatch.setattr(viscosity, "v_at_time", _FailOnce(viscosity.v_at_time, 2))
     monkeypatch.setattr(viscosity, "_piezo_kernel", _rows_as_threads(
         viscosity._piezo_case.py_func, lambda a: a[2].p0.size, 7))
     with pytest.raises(RuntimeError, match="1 of 3 rows were not computed .first: row 1."):
@@ -93,7 +94,7 @@ def test_barus_quadrature_row_failing_in_its_time_loop_is_not_returned(tables, m
 
 def test_barus_tire_row_failing_at_its_exit_is_not_returned(tables, monkeypatch):
     # _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out)
-    monkeypatch.setattr(tire_piezo, "exit_w", _FailOnce(tire_piezo.exit_w, 3))
+    monkeypatch.setattr(tire_piezo, "v_at_time", _FailOnce(tire_piezo.v_at_time, 3))
     monkeypatch.setattr(tire_piezo, "_tire_kernel", _rows_as_threads(
         tire_piezo._tire_case.py_func, lambda a: a[2].p0.size, 8))
     with pytest.raises(RuntimeError, match="1 of 3 rows were not computed .first: row 2."):
