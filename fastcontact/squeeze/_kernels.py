@@ -452,6 +452,13 @@ def _case_times(tab, mp, film, tg, h, quad, i, out):
 TRAPPED_WIDTH = 1.0 / 3.0
 
 
+@njit(cache=True, inline="always")
+def trapped_quad(quad):
+    """The quadrature of a trapped row: panels of TRAPPED_WIDTH times ``quad``'s width (in
+    w = ln(v - v_trap); the constant-viscosity and the Barus engines alike)."""
+    return Quad(quad.glx, quad.glw, TRAPPED_WIDTH * quad.width)
+
+
 @njit(cache=True)
 def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
     """Everything for one case by quadrature, written in SI to column i of ``out``."""
@@ -467,8 +474,8 @@ def quad_case(tab, mp, x0, vs_in, tg, tau, h, quad, i, out):
         out.u_inf[i] = film.vinf * h
         out.status[i] = ST_BELOW
         return
-    if film.trapped:  # half the panel width on the trapped side (TRAPPED_WIDTH)
-        quad = Quad(quad.glx, quad.glw, TRAPPED_WIDTH * quad.width)
+    if film.trapped:  # a third of the panel width on the trapped side (TRAPPED_WIDTH)
+        quad = trapped_quad(quad)
     _case_targets(tab, mp, film, tg, quad, i, out)
     _case_times(tab, mp, film, tg, h, quad, i, out)
     # last: a worker thread that fails above stops without raising, and the row must keep

@@ -166,7 +166,7 @@ def _shared_kernel(tab, mp, lvb, z, g, lnp):
 
 
 @njit(cache=True, inline="always")
-def _gap(x0, g, lnp, k):
+def _gap(x0, lnp, k):
     """1 - π_c/π0 at point k on the row x0 (floored at 1e-300 as the quadrature's)."""
     d = -math.expm1(lnp[k] - x0)
     return d if d > 1e-300 else 1e-300
@@ -181,7 +181,7 @@ def _row_sums(x0, g, lnp, pw, off, T_top, T):
     for q in range(off.size - 1):
         s = 0.0
         for k in range(off[q], off[q + 1]):
-            s += pw[k] * g[k] / _gap(x0, g, lnp, k)
+            s += pw[k] * g[k] / _gap(x0, lnp, k)
         acc += s
         T[q + 1] = acc
 
@@ -225,7 +225,7 @@ def _rows_kernel(x0s, pg, plnp, pw, off, T_ext, piece_of, k_of, station, T_tail,
         for n in range(k_of.size):
             q = station[n]
             Tn = T[q] if q >= 0 else T_tail[n]
-            d = _gap(x0, ng, nlnp, n)
+            d = _gap(x0, nlnp, n)
             h = ng[n] / d
             dl = dlg[n] + (1.0 - d) * dlp[n] / d
             k = k_of[n]

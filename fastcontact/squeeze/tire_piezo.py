@@ -31,7 +31,7 @@ from ..kernels.quadrature import gauss_legendre
 from ..kernels.readonly import readonly, readonly_fields
 from ._kernels import Cases, Quad, check_computed, new_status, reduced_time
 from .api import STATUS_NAMES
-from .viscosity import (BarusTargets, _case_head, _case_start, _lnv_of_lnp, _scalars,
+from .viscosity import (BarusTargets, _case_head, _case_start, _scalars,
                         _state, _target_times, fast_scratch, fast_setup, flag_overflow,
                         trap_floor_v, v_at_time)
 
@@ -73,8 +73,9 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
         return
     x_trap = sc[0].x_trap
     trapped = x0 >= x_trap
+    vb = trap_floor_v(tab, sc, x0)  # NaN unless trapped
     if trapped:
-        out.u_trap[i] = math.exp(_lnv_of_lnp(tab, sc, x_trap)) * h
+        out.u_trap[i] = vb * h
         out.flf[i] = -math.expm1(x_trap - x0)
     else:
         out.flf[i] = 0.0
@@ -85,11 +86,10 @@ def _tire_case(tab, sc, cs, alpha, t_fp, h, tg, quad, i, out):
         out.flf[i] = math.nan
         out.u_trap[i] = math.nan
         return
-    _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i)
+    _target_times(tab, sc, x0, api, vinf, vb, vs, tau, tg, quad, T, i)
     if t_fp.size:  # no footprint times: the exit is not asked for
         # tt = inf (τ0 = 0, a row flagged "overflow" afterwards): ū∞, or ū_trap if trapped
-        out.u_exit[i] = v_at_time(tab, sc, x0, api, vinf,
-                                  trap_floor_v(tab, sc, x0), vs, reduced_time(t_fp[i], tau),
+        out.u_exit[i] = v_at_time(tab, sc, x0, api, vinf, vb, vs, reduced_time(t_fp[i], tau),
                                   quad) * h
     # last (a failing worker thread stops without raising: the row keeps NOT_COMPUTED)
     out.status[i] = _TRAPPED if trapped else _OK

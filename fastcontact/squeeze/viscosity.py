@@ -37,8 +37,8 @@ from .model import squeeze_model
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.records import scalar_record
 from ..kernels.readonly import readonly, readonly_fields
-from ._kernels import (TRAPPED_WIDTH, Cases, Quad, check_computed, kink_w, new_status,
-                       reduced_time, state_gap)
+from ._kernels import (Cases, Quad, check_computed, kink_w, new_status, reduced_time,
+                       state_gap, trapped_quad)
 from ._kernels import _lnv_of_lnp as qk_lnv_of_lnp
 from ._kernels import _state as qk_state
 
@@ -246,13 +246,6 @@ def trap_floor_v(tab, sc, x0):
     return math.exp(_lnv_of_lnp(tab, sc, x_trap)) if x0 >= x_trap else math.nan
 
 
-@njit(cache=True, inline="always")
-def _trapped_quad(quad):
-    """The quadrature of a trapped row: panels of TRAPPED_WIDTH times the width (in
-    w = ln(v - v_trap); as the constant-viscosity engine's trapped rows)."""
-    return Quad(quad.glx, quad.glw, TRAPPED_WIDTH * quad.width)
-
-
 @njit(cache=True)
 def _trapped_target_times(tab, sc, x0, api, vinf, vb, vs, tau, tg, quad, T, i):
     """:func:`_target_times` of a trapped row (floor vb = v_trap): w = ln(v - v_trap), where
@@ -263,7 +256,7 @@ def _trapped_target_times(tab, sc, x0, api, vinf, vb, vs, tau, tg, quad, T, i):
     vt_ratio = tg.ratios
     nt = T.shape[0]
     nr = vt_ratio.size
-    q = _trapped_quad(quad)
+    q = trapped_quad(quad)
     wts = np.empty(nt)
     vts = np.empty(nt)
     for k in range(nt):
@@ -297,16 +290,15 @@ def v_at_time(tab, sc, x0, api, vinf, vb, vs, tt, quad):
     vr = vb if trapped else vinf
     if tt == math.inf:
         return vr
-    q = _trapped_quad(quad) if trapped else quad
+    q = trapped_quad(quad) if trapped else quad
     return vr + math.exp(exit_w(tab, sc, x0, api, vr, math.log(vs - vr), tt, q))
 
 
 @njit(cache=True)
-def _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, T, i):
+def _target_times(tab, sc, x0, api, vinf, vb, vs, tau, tg, quad, T, i):
     """Times [s] from v_start down to each target of ``tg`` (:data:`BarusTargets`) into
     column i of T: one downward pass over the targets in descending order; 0 for targets
-    passed (a trapped row: :func:`_trapped_target_times`)."""
-    vb = trap_floor_v(tab, sc, x0)
+    passed (a trapped row, vb = :func:`trap_floor_v` not NaN: :func:`_trapped_target_times`)."""
     if vb == vb:
         _trapped_target_times(tab, sc, x0, api, vinf, vb, vs, tau, tg, quad, T, i)
         return
@@ -411,8 +403,8 @@ def _piezo_case(tab, sc, cs, alpha, h, tg, quad, i, out):
     if api * d_start >= 1.0:
         _no_times(out, i, np.int64(ST_PIEZO))
         return
-    _target_times(tab, sc, x0, api, vinf, vs, tau, tg, quad, out.T, i)
     vb = trap_floor_v(tab, sc, x0)
+    _target_times(tab, sc, x0, api, vinf, vb, vs, tau, tg, quad, out.T, i)
     for k in range(tg.times.size):
         # inf: ū∞, or ū_trap on a trapped row (as the base engine; no walk of W_SPAN panels)
         out.U[k, i] = v_at_time(tab, sc, x0, api, vinf, vb, vs, reduced_time(tg.times[k], tau),
