@@ -79,6 +79,39 @@ def test_tire_exit_vs_reference(T):
         assert abs(du - (v_ref - ref.v_inf)) <= max(1e-6 * (v_ref - ref.v_inf), 1e-8 * ref.v_inf)
 
 
+
+
+@pytest.mark.parametrize("theory", ["critical_junction", "emt"])
+def test_film_deep_in_the_exponential_approach_vs_reference(T, theory):
+    """ū at times far into the exponential approach to ū∞ (a tire footprint at tire pressures
+    ends there): ū - ū∞ = ū∞ e^z follows the reference's decay z(t) while it is representable
+    (z >= -32: within 0.05 in z; z = -34, ~8 ulps of ū∞: still above ū∞) and is ū∞ exactly
+    once e^z is below half an ulp (z <= -40). The reference's time to z = -20 is its
+    quadrature; beyond, z falls linearly at the rate 1/S, S = 1/(σ̄(ū∞) κ) the relaxation time,
+    κ = -d ln π_c/dv at v∞ (central difference on the direct core: error ~1e-8)."""
+    p0, u0 = 0.2e6, 1e-2
+    h = T.h_rms
+    ref = SqueezeReference(T.surface, E, theory, p0)
+    tau = tau0(ETA, R, h, p0)
+    vi = ref.v_inf
+    t20 = ref.time(vi * (1.0 + math.exp(-20.0)), u0 / h)
+    dv = 1e-4 * vi
+    kappa = -(ref.state(vi + dv)[0] - ref.state(vi - dv)[0]) / (2.0 * dv)
+    S = 1.0 / (ref.state(vi)[1] * kappa)
+    zk = np.array([-20.0, -26.0, -30.0, -32.0, -34.0, -40.0, -45.0, -48.0, -50.0, -60.0, -200.0])
+    times = tau * (t20 + (-20.0 - zk) * S)
+    row = squeeze_out(T, p0=p0, E_star=E, R=R, eta=ETA, theory=theory, u_start=u0, ratios=(),
+                      times=times, method="fast").iloc[0]
+    assert row["status"] == "ok"
+    u_inf = row["u_inf"]
+    for z, t in zip(zk, times):
+        u = row[column_name("u_at", t)]
+        if z >= -32.0:
+            assert abs(math.log(u / u_inf - 1.0) - z) < 0.05, (z, u / u_inf - 1.0)
+        elif z >= -34.0:
+            assert u > u_inf, (z, u, u_inf)
+        elif z <= -40.0:
+            assert u == u_inf, (z, u, u_inf)
 # ------------------------------------------------------------------ vs the quadrature
 @pytest.mark.parametrize("theory", ["average", "critical_junction", "emt"])
 def test_fast_matches_quad_per_case_start_du_times(T, theory):

@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .._core.owned import own_columns
 from .._core.validate import align_inputs, check_positive
 from .._core.vocab import DEFAULT_THEORY
 from . import _panels
@@ -55,6 +56,11 @@ REFERENCES = (
     "with experiment, Eur. Phys. J. E 31, 159 (2010), arXiv:0911.3019",
 )
 
+
+#: the result columns that echo an input (views of the caller's arrays until
+#: :func:`~fastcontact._core.owned.own_columns` gives them their own memory)
+INPUT_COLUMNS = ("p0", "dp", "p_b", "L", "L_y", "E_star", "eta", "alpha_cj", "R", "f_N",
+                 "alpha_pv", "roelands_z", "roelands_p_r", "roelands_eta_inf")
 
 _BASE = ("Q", "lift_off", "percolated", "status")
 _COLUMNS = {
@@ -300,7 +306,7 @@ def seal_leak(tables, *, p0=None, dp, L=None, L_y, E_star, eta, theory=DEFAULT_T
 def _frame(cols, shape, theory, kind):
     """The result DataFrame of :func:`seal_leak`: the columns of ``kind``, units, references."""
     names = _COLUMNS[kind]
-    df = pd.DataFrame({c: cols[c] for c in names}, copy=False)
+    df = pd.DataFrame(own_columns({c: cols[c] for c in names}, INPUT_COLUMNS), copy=False)
     df.attrs.update({"shape": tuple(shape), "theory": theory, "profile": kind,
                      "units": {c: UNITS[c] for c in names}, "references": list(REFERENCES)})
     return df

@@ -55,6 +55,7 @@ from collections import OrderedDict
 import numpy as np
 import pandas as pd
 
+from .._core.owned import own_columns
 from .._core.validate import check_positive
 from ..flow.piezoviscosity import ROELANDS_ETA_INF, check_law, roelands_parameters
 from ..kernels.quadrature import gauss_legendre
@@ -818,7 +819,8 @@ def _piezo_frame(cols, law, theory, profile, shape, roelands_eta_inf):
     roelands = law is not None
     if roelands:
         cols["roelands_z"] = law[1]
-    df = pd.DataFrame(cols, copy=False)
+    from .api import INPUT_COLUMNS  # (api imports this module)
+    df = pd.DataFrame(own_columns(cols, INPUT_COLUMNS), copy=False)
     refs = ["doi:10.2475/ajs.s3-45.266.87", "arXiv:0911.3019"]
     if roelands:
         refs = ["C.J.A. Roelands, PhD thesis, TU Delft (1966)",

@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from .._core.owned import own
 from .._core.validate import align_inputs, as_float_array, check_positive
 from .._core.vocab import DEFAULT_THEORY, REFERENCES, column_name
 from ..tables import Tables
@@ -334,7 +335,9 @@ def frame(model, cs, out, ratios, du, times, order, names, method):
     """The result DataFrame of :func:`squeeze_out` from the kernel outputs."""
     status = out.status
     trapped, perc, oot = status_flags(status, out.u_trap, cs.p0, cs.E, model.x_perc)
-    cols = {"p0": cs.p0, "E_star": cs.E, "R": cs.R, "eta": cs.eta, "u_start": out.u_start,
+    # the input columns are views of the caller's arrays where no conversion was needed
+    cols = {"p0": own(cs.p0), "E_star": own(cs.E), "R": own(cs.R), "eta": own(cs.eta),
+            "u_start": out.u_start,
             "u_inf": out.u_inf, "t_star": out.T[0]}
     k = 1
     for name in names[7:7 + ratios.size + du.size]:
@@ -427,7 +430,7 @@ def squeeze_history(tables, p0, E_star, R, eta, theory=DEFAULT_THEORY, t=None, u
         u[order] = out.U[:, 0]
     ratio, p_fluid, flat = history_columns(model, u, t, p0, E_star, eta, R,
                                            float(row["u_start"]))
-    out = pd.DataFrame({"t": t, "u": u, "p_cont_over_p0": ratio, "p_fluid_mean": p_fluid,
+    out = pd.DataFrame({"t": own(t), "u": u, "p_cont_over_p0": ratio, "p_fluid_mean": p_fluid,
                         "u_flat": flat}, copy=False)
     out.attrs.update(df.attrs)
     out.attrs["units"] = {"t": "s", "u": "m", "p_cont_over_p0": "1", "p_fluid_mean": "Pa",

@@ -43,6 +43,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from .._core.owned import own
 from .._core.validate import as_float_array, check_positive
 from .._core.vocab import DEFAULT_THEORY, column_name
 from ..kernels.readonly import readonly_fields
@@ -334,7 +335,8 @@ def tire_footprint(tables, *, p0, E_star, R, eta, footprint_length, speed, rho=1
     p_peak = b["p0"] * peak
     p_eval = b["p0"] if pressure_model == "mean" else p_peak
     t_fp = b["footprint_length"] / b["speed"]
-    out = {"p_eval": p_eval, "p_peak": p_peak, "t_footprint": t_fp}
+    # p_eval is the caller's p0 itself for the mean pressure model: a column of its own
+    out = {"p_eval": own(p_eval), "p_peak": p_peak, "t_footprint": t_fp}
     u_used = b.get("u_start")
     model = None
     if want - {"p_eval", "p_peak", "t_footprint", "tau_inertia"}:
@@ -380,7 +382,7 @@ def tire_history(tables, *, p0, E_star, R, eta, t, theory=DEFAULT_THEORY,
                        model.h_rms, t, u)
     else:
         u = squeeze_history(tables, p0, E_star, R, eta, theory, t, u_start=u_start)["u"].to_numpy()
-    df = pd.DataFrame({"t": t, "u": u, "du": u - u_inf, "u_inf": np.full(t.size, u_inf)},
+    df = pd.DataFrame({"t": own(t), "u": u, "du": u - u_inf, "u_inf": np.full(t.size, u_inf)},
                       copy=False)
     df.attrs.update(one.attrs)
     df.attrs["units"] = {"t": "s", "u": "m", "du": "m", "u_inf": "m"}

@@ -30,6 +30,7 @@ import numpy as np
 import pandas as pd
 from numba import njit, prange
 
+from .._core.owned import own
 from .._core.validate import check_positive
 from .._core.vocab import DEFAULT_THEORY, column_name
 from .api import register_extension, squeeze_out
@@ -666,8 +667,9 @@ def _check_targets(ratios, du, quad_order, quad_width):
 def _piezo_frame(flat, ratios, du, times, T, U, uinf, ustart, tau0, gs, status, theory,
                  method):
     """The result DataFrame of :func:`squeeze_out_piezo` from the kernel outputs."""
-    cols = {"p0": flat[0], "E_star": flat[1], "R": flat[2], "eta": flat[3],
-            "alpha_pv": flat[4], "u_start": ustart, "u_inf": uinf, "t_star": T[0]}
+    cols = {"p0": own(flat[0]), "E_star": own(flat[1]), "R": own(flat[2]),
+            "eta": own(flat[3]), "alpha_pv": own(flat[4]), "u_start": ustart, "u_inf": uinf,
+            "t_star": T[0]}
     for k, r in enumerate(ratios):
         cols[column_name("t_ratio", r)] = T[1 + k]
     for k, d in enumerate(du):
