@@ -63,9 +63,10 @@ def node_points(theory):
 #: x0-independent state along s = ln v (cubic Hermite on a fine uniform grid, below the table
 #: top): ell = ln π_c, lam = ln σ̄ and their s-derivatives; above v_top the analytic tail
 Profile = namedtuple("Profile", "s0 ds A")  # A[i] = (ell, dell, lam, dlam) at s0 + i ds
-#: spacing of the profile grid in ln v and the central-difference step of its derivatives where
-#: the tables' interpolants give none (:func:`_profile_kernel`)
-PROFILE_DS = 0.004
+#: spacing of the profile grid in ln v (see :data:`X_END`: 0.004 left 7.6e-7 in t next to
+#: the kink; the profile build costs the same) and the central-difference step of its
+#: derivatives where the tables' interpolants give none (:func:`_profile_kernel`)
+PROFILE_DS = 0.001
 PROFILE_FD = 1e-5
 
 
@@ -353,17 +354,21 @@ def profile(model, v_lo):
     return Profile(s0, ds, A)
 
 
-#: rows end X_END below the trap pressure (or the tables' kink, :func:`_kink`); cases within
-#: X_FALLBACK of it use the per-case quadrature (p0 above 0.956 of it; σ̄ collapses there
-#: faster than any fixed grid resolves). The last rows resolve T at the grid's bottom less
-#: well, and deep in the exponential approach (ū − ū∞ ∝ e^(-t/t_relax), where an error δT of
-#: T moves ln(ū − ū∞) by δT/S) that shows: with margins of 0.01 (trap) and 0.02 (kink), as
-#: before 2026-11-27, ū − ū∞ at 0.5–15 t_relax past t* was off the per-case quadrature by more
-#: than 1e-6 (up to 2.4e-6; the quadrature within 2e-8 of the independent reference there) up
-#: to 0.028 below the rows' end (critical junction and EMT, three of the four embedded tables;
-#: t* within 2e-7); with 0.045, by at most 3.6e-7 in the top 0.05 of the served range
-X_END = 0.005
-X_FALLBACK = 0.045
+#: rows end X_END below the trap pressure and the tables' kink (:func:`_kink`), and at the
+#: tables' last node below the trap pressure (:func:`_x_hi`); the primitive serves cases up to
+#: X_FALLBACK below its last row, the per-case quadrature those above (up to the trap
+#: pressure, and between the kink and the trap pressure). Until 2026-12-07 the rows ended
+#: 0.005 below min(trap, kink) and served up to 0.045 below it: with the profile at 0.004 in
+#: ln v, ū − ū∞ deep in the exponential approach and t at ū = 1.001 ū∞ were off the per-case
+#: quadrature by up to 2.4e-6 there. Two causes, both removed: the profile's cubic cells
+#: (t up to 7.6e-7 off 0.002 below the kink of asphalt_024mm at 0.004, 4e-9 at 0.001), and a
+#: 4-point stencil straddling the last table node below the trap (1.9e-6 of T at cell
+#: centres 0.003 below the trap of asphalt_072mm, where σ̄ falls from 1e-22.5 to 1e-90 in
+#: one table interval). Now, on the four embedded tables × (critical junction, EMT), from
+#: 0.06 below the top to the last row: t within 1.7e-8 and ū − ū∞ within 2e-8 of the
+#: quadrature at t* + (0 … 15) t_relax
+X_END = 1e-4
+X_FALLBACK = 0.0
 
 
 def _kink(model):
@@ -373,10 +378,29 @@ def _kink(model):
     return float(lnp[n_open - 1]) if n_open < lnp.size else math.inf
 
 
+def _last_node_below_trap(model):
+    """ln p̄ of the tables' last node below the trap pressure (inf: no trap)."""
+    if not math.isfinite(model.x_trap):
+        return math.inf
+    lnp = model.tab.lnp[:int(model.tab.n_open)]
+    k = int(np.searchsorted(lnp, model.x_trap, side="left")) - 1
+    return float(lnp[k]) if k >= 0 else -math.inf
+
+
+def _x_hi(model):
+    """ln(p0/E*) of the primitive's last row: X_END below the trap pressure and the tables'
+    kink, and not beyond the tables' last node below the trap (T(x0) is only C² across a
+    table node, and across the one below the trap, where σ̄ falls by tens of decades, that is
+    too little for a 4-point stencil: rows end there, and the stencil never straddles it).
+    On the embedded tables this is their last node whose σ̄ the table build verified (the
+    seal engine's trusted top; σ̄ ≈ 1e-23 there): above it the tables' σ̄ is unverified."""
+    return min(model.x_trap - X_END, _kink(model) - X_END, _last_node_below_trap(model),
+               model.x_max)
+
+
 def fast_limit(model):
     """Largest ln(p0/E*) the primitive serves (above: per-case quadrature)."""
-    lim = min(model.x_trap, _kink(model)) - X_FALLBACK
-    return min(lim, model.x_max)
+    return _x_hi(model) - X_FALLBACK
 
 
 @njit(parallel=True, cache=True)
@@ -388,7 +412,7 @@ def _sigma_samples(tab, xs, out):
 
 def _x_nodes(model, dxi):
     """x0 nodes uniform in ξ = x0 - ln σ̄(x0) on [x_min, x_hi]."""
-    x_hi = min(model.x_trap - X_END, _kink(model) - X_END, model.x_max)
+    x_hi = _x_hi(model)
     xs = np.linspace(model.x_min, x_hi, 20001)
     sig = np.empty(xs.size)
     _sigma_samples(model.tab, xs, sig)
@@ -434,10 +458,12 @@ def build(model, dxi=DXI, z_lo=Z_LO, dz=DZ, points=None, check=True):
 
 
 def measure_error(model, pr, pf, n_x=64, order=CHECK_ORDER):
-    """Max relative error of the interpolated T at cell centres (n_x x0 cells × all z cells)."""
+    """Max relative error of the interpolated T at cell centres (n_x random x0 cells and the
+    last four the fast path serves, × all z cells)."""
     rng = np.random.default_rng(0)
     served = int(np.searchsorted(pr.xn, fast_limit(model), side="right")) - 1
-    cells = np.unique(rng.integers(0, max(served, 1), n_x))  # cells the fast path serves
+    cells = np.unique(np.concatenate([rng.integers(0, max(served, 1), n_x),  # served cells,
+                                      np.arange(max(served - 4, 0), served)]))  # the top 4
     xm = 0.5 * (pr.xn[cells] + pr.xn[cells + 1])
     zc = pr.z0 + (np.arange(pr.nz - 1) + 0.5) * pr.dz
     X, Z = np.meshgrid(xm, zc, indexing="ij")
