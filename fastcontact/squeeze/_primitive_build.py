@@ -22,6 +22,7 @@ from ..kernels.locate import locate_asc, locate_desc
 from ..kernels.lookup import sigma_interval_resolved, sigma_linear
 from ..kernels.quadrature import gauss_legendre, gauss_lobatto
 from ..kernels.readonly import readonly_fields
+from ..tables.build import SIGMA_FLOOR
 from . import _kernels as qk
 from ._primitive_eval import (Primitive, _index_map, lagrange_denominators, one_plus_exp,
                               row_value, stencil, t_of_z)
@@ -355,7 +356,7 @@ def profile(model, v_lo):
 
 
 #: rows end X_END below the trap pressure and the tables' kink (:func:`_kink`), and at the
-#: tables' last node below the trap pressure (:func:`_x_hi`); the primitive serves cases up to
+#: tables' last verified node (:func:`_x_hi`); the primitive serves cases up to
 #: X_FALLBACK below its last row, the per-case quadrature those above (up to the trap
 #: pressure, and between the kink and the trap pressure). Until 2026-12-07 the rows ended
 #: 0.005 below min(trap, kink) and served up to 0.045 below it: with the profile at 0.004 in
@@ -378,23 +379,28 @@ def _kink(model):
     return float(lnp[n_open - 1]) if n_open < lnp.size else math.inf
 
 
-def _last_node_below_trap(model):
-    """ln p̄ of the tables' last node below the trap pressure (inf: no trap)."""
-    if not math.isfinite(model.x_trap):
+def _verified_top(model):
+    """ln p̄ of the tables' last node whose σ̄ lies above the tables' σ̄ floor: the build
+    verifies σ̄'s interpolant only between such nodes (beyond it, in the super-exponential
+    collapse towards percolation, σ̄ is unverified; the seal engine's trusted top too).
+    inf for a theory without percolation ("average": σ̄ = (ū/h_rms)³, verified through ū at
+    every node, falls below the floor only by ū's own decay)."""
+    if not math.isfinite(model.x_perc):
         return math.inf
-    lnp = model.tab.lnp[:int(model.tab.n_open)]
-    k = int(np.searchsorted(lnp, model.x_trap, side="left")) - 1
-    return float(lnp[k]) if k >= 0 else -math.inf
+    n_open = int(model.tab.n_open)
+    floor = float(model.tables.info.get("sigma_floor", SIGMA_FLOOR))
+    k = int(np.count_nonzero(np.asarray(model.tab.lnsig[:n_open]) > math.log(floor))) - 1
+    return float(model.tab.lnp[k]) if k >= 0 else -math.inf
 
 
 def _x_hi(model):
     """ln(p0/E*) of the primitive's last row: X_END below the trap pressure and the tables'
-    kink, and not beyond the tables' last node below the trap (T(x0) is only C² across a
-    table node, and across the one below the trap, where σ̄ falls by tens of decades, that is
-    too little for a 4-point stencil: rows end there, and the stencil never straddles it).
-    On the embedded tables this is their last node whose σ̄ the table build verified (the
-    seal engine's trusted top; σ̄ ≈ 1e-23 there): above it the tables' σ̄ is unverified."""
-    return min(model.x_trap - X_END, _kink(model) - X_END, _last_node_below_trap(model),
+    kink, and not beyond the tables' last verified node (:func:`_verified_top`). With the
+    default trap floor (the tables' σ̄ floor) the trap pressure lies in the interval after
+    that node, where σ̄ falls by tens of decades (1e-22.5 to 1e-90 on asphalt_072mm): T(x0)
+    is only C² across the node, too little for a 4-point stencil, so the rows end there and
+    the stencil never straddles it."""
+    return min(model.x_trap - X_END, _kink(model) - X_END, _verified_top(model),
                model.x_max)
 
 
