@@ -9,6 +9,9 @@ error of the times to targets above ū_trap and of t_trap against the independen
 of ``tests/reference/trapped_reference.py`` (panels broken at the tables' nodes). Speed: median
 wall time of repeats (the primitive built before, and its build, its build with the error
 check, and the first call of a 1,000-case trapped study on newly read tables timed separately).
+A second table: the cases just below the trap pressure that the equilibrium side's primitive
+serves since 2026-12-07 (before: the per-case quadrature), against the same run's quadrature
+and the independent quadrature of the same tables.
 """
 from __future__ import annotations
 
@@ -26,11 +29,12 @@ sys.path.insert(0, str(HERE))
 
 from fastcontact._core.vocab import column_name  # noqa: E402
 from fastcontact.squeeze import _trap_primitive as tpm  # noqa: E402
+from fastcontact.squeeze import primitive as prim  # noqa: E402
 from fastcontact.squeeze import squeeze_model, squeeze_out  # noqa: E402
 from fastcontact.tables import Tables  # noqa: E402
 from fastcontact.tables.defaults import default_table_path  # noqa: E402
 from machine_info import cpu_model  # noqa: E402
-from reference.trapped_reference import TrappedReference  # noqa: E402
+from reference.trapped_reference import BelowTrapReference, TrappedReference  # noqa: E402
 from results_notes import write_keeping_notes  # noqa: E402
 
 SURFACES = ("asphalt_024mm", "asphalt_072mm")
@@ -67,9 +71,47 @@ def errors(T, m, method, n=10):
     return e_t, e_trap
 
 
+#: the band below the trap pressure that the time primitive serves since 2026-12-07: from
+#: OLD_MARGIN below min(trap pressure, tables' kink) (the fast path's limit before) to its limit
+OLD_MARGIN = 0.045
+
+
+def below_cases(m, n, seed):
+    """Cases log-uniform in ln p0 over the band below the trap pressure that the primitive now
+    serves (before 2026-12-07: the per-case quadrature), per-case starts 1.1–40 ū∞ (from a
+    base call), ratio targets 1.01 and 1.001, ū at two times."""
+    rng = np.random.default_rng(seed)
+    top = min(m.x_trap, float(m.tab.lnp[int(m.tab.n_open) - 1]))
+    x0 = rng.uniform(top - OLD_MARGIN, prim.fast_limit(m), n)
+    return dict(p0=np.exp(x0) * E, E_star=E, R=rng.uniform(0.005, 0.02, n), eta=ETA,
+                theory=m.theory, ratios=(1.01, 1.001), times=(1e6, 1e9))
+
+
+def below_errors(T, m, method, n=10):
+    """Max relative error of t*, t_ratio_1.001 and (as time, in t_relax) ū at t* + 2 t_relax
+    on n cases of :func:`below_cases`, against the independent quadrature of the same tables
+    (`tests/reference/trapped_reference.py`, BelowTrapReference)."""
+    kw = below_cases(m, n, 13)
+    df = squeeze_out(T, method=method, **kw)
+    e_t = e_u = 0.0
+    for i in range(n):
+        p0 = kw["p0"][i]
+        x0 = math.log(p0 / E)
+        ref = BelowTrapReference(m, x0)
+        row = df.iloc[i]
+        tau = row["tau0"]
+        e_t = max(e_t, abs(row["t_star"] / tau / ref.time(0.01 * ref.v_inf) - 1.0),
+                  abs(row["t_ratio_1.001"] / tau / ref.time(1e-3 * ref.v_inf) - 1.0))
+        t = row["t_star"] + 2.0 * row["t_relax"]
+        one = squeeze_out(T, method=method, **{**kw, "p0": p0, "R": kw["R"][i],
+                                               "times": (t,)}).iloc[0]
+        dv = one[column_name("u_at", t)] / m.h_rms - ref.v_inf
+        e_u = max(e_u, abs(tau * ref.time(dv) - t) / row["t_relax"])
+    return e_t, e_u
+
+
 def rate(T, kw, repeats):
-    squeeze_out(T, **{**kw, "p0": kw["p0"][:64], "R": kw["R"][:64],
-                      "u_start": kw["u_start"][:64]})
+    squeeze_out(T, **{k: v[:64] if isinstance(v, np.ndarray) else v for k, v in kw.items()})
     ts = []
     for _ in range(repeats):
         t0 = time.perf_counter()
@@ -145,7 +187,7 @@ def main(quick=False):
     n_fast, n_quad, rep = (50_000, 200, 2) if quick else (400_000, 1_000, 5)
     n_hist = 100_000 if quick else 1_000_000
     load0 = os.getloadavg()
-    rows, hrows = [], []
+    rows, hrows, brows = [], [], []
     for name in SURFACES:
         T = Tables.from_parquet(default_table_path(name))
         for th in THEORIES:
@@ -159,6 +201,10 @@ def main(quick=False):
             b, bc, first, info = build_time(name, th, rep)
             rows.append((name, th, f, q, ef, eq, b, bc, first, info))
             hrows.append((name, th) + history(T, m, n_hist, n_quad, rep))
+            kb = below_cases(m, n_fast, 7)
+            kbq = {**kb, "p0": kb["p0"][:n_quad], "R": kb["R"][:n_quad], "method": "quad"}
+            brows.append((name, th, rate(T, kb, rep), rate(T, kbq, max(2, rep - 2)),
+                          below_errors(T, m, "fast"), below_errors(T, m, "quad")))
     load1 = os.getloadavg()
     L = ["## Trapped rows of squeeze-out (issue 11.1) — `bench/bench_trapped.py`", "",
          f"Machine: {cpu_model()}, {os.cpu_count()} cores, numba threads "
@@ -189,6 +235,20 @@ def main(quick=False):
           "history: max err |", "|---|---|---|---|---|---|"]
     for name, th, fh, qh, eh in hrows:
         L.append(f"| {name} | {th} | {fh:.3g} | {qh:.3g} | {fh / qh:.3g} | {eh:.1e} |")
+    L += ["", f"Just below the trap pressure (not trapped): {n_fast:,} (fast) and {n_quad:,} "
+          f"(quad) cases, ln p0 uniform from {OLD_MARGIN} below min(trap pressure, the tables' "
+          "last open node) to the fast path's limit (the band the primitive serves since "
+          "2026-12-07; before, the per-case quadrature), default start, targets 1.01 ū∞ and "
+          "1.001 ū∞, ū at two times. Errors on 10 cases against the independent quadrature of "
+          "the same tables (BelowTrapReference: ū∞ and the start by brentq, panels broken at "
+          "the tables' nodes): t* and t to 1.001 ū∞ relative; ū at t* + 2 t_relax as the "
+          "reference time to it, in t_relax.", "",
+          "| tables | theory | fast: cases/s | quad: cases/s | fast / quad | fast: err t | "
+          "fast: err ū [t_relax] | quad: err t | quad: err ū [t_relax] |",
+          "|---|---|---|---|---|---|---|---|---|"]
+    for name, th, f, q, ef, eq in brows:
+        L.append(f"| {name} | {th} | {f:.3g} | {q:.3g} | {f / q:.3g} | {ef[0]:.1e} | "
+                 f"{ef[1]:.1e} | {eq[0]:.1e} | {eq[1]:.1e} |")
     L.append("")
     write_keeping_notes(HERE / "trapped_results.md", "\n".join(L) + "\n")
     print("\n".join(L))

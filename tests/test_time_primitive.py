@@ -113,20 +113,6 @@ def test_film_deep_in_the_exponential_approach_vs_reference(T, theory):
         elif z <= -40.0:
             assert u == u_inf, (z, u, u_inf)
 # ------------------------------------------- next to the trap pressure, vs the tables' reference
-def _root_v(m, x):
-    """v with ln π_c(v) = x on the tables' interpolant (brentq; independent of the engine's
-    Newton solves)."""
-    from scipy.optimize import brentq
-
-    from fastcontact.squeeze import _kernels as qk
-
-    def f(lv):
-        return qk._state(m.tab, m.mp, math.exp(lv))[0] - x
-
-    lo, hi = math.log(m.tables.u_range[0]) + 1e-12, math.log(m.tables.u_range[1]) - 1e-12
-    return math.exp(brentq(f, lo, hi, xtol=1e-15, rtol=1e-15, maxiter=400))
-
-
 @pytest.mark.parametrize("name,theory,sigma_trap", [("asphalt_024mm", "critical_junction", None),
                                                     ("asphalt_072mm", "critical_junction", None),
                                                     ("asphalt_072mm", "emt", None),
@@ -142,27 +128,17 @@ def test_rows_next_to_the_trap_pressure_vs_the_tables_reference(name, theory, si
     start by brentq). Until 2026-12-07 the fast path stopped 0.045 below min(trap, kink); with
     its profile at 0.004 in ln v or a stencil across the last node below the trap it was off
     by up to 3e-6 here (asphalt_072mm critical junction, 0.003 below the trap: 3e-6 in t)."""
-    from reference.trapped_reference import _gl_sum
+    from reference.trapped_reference import BelowTrapReference
 
     T_ = Tables.from_parquet(default_table_path(name))
     m = squeeze_model(T_, theory, sigma_trap)
     lim = prim.fast_limit(m)
     top = min(m.x_trap, float(m.tab.lnp[int(m.tab.n_open) - 1]))
     assert top - 0.02 < lim < top  # served to within 0.02 of the top (was 0.045)
-    v = np.sort(np.append(np.exp(np.asarray(m.tab.lnu, dtype=np.float64)), m.mp.v_top))
-    gx, gw = np.polynomial.legendre.leggauss(12)
     for x0 in lim - np.array([0.03, 0.003, 3e-4, 0.0]):
         p0 = math.exp(x0) * E
-        vinf = _root_v(m, x0)
-        vs = _root_v(m, x0 + math.log(1e-3))  # the default start: p_cont = 1e-3 p0
-        br = np.ascontiguousarray(np.log(v[v > vinf * (1 + 1e-12)] - vinf))
-
-        def t_ref(dv_lo):  # τ0 units, from the start down to ū∞ + dv_lo [h_rms]
-            wa, wb = math.log(dv_lo), math.log(vs - vinf)
-            a, b = (_gl_sum(m.tab, m.mp, x0, vinf, wa, wb, br, w, gx, gw) for w in (0.05, 0.025))
-            assert abs(a / b - 1.0) < 1e-10
-            return b
-
+        ref = BelowTrapReference(m, x0)
+        vinf = ref.v_inf
         tau = tau0(ETA, R, T_.h_rms, p0)
         kw = dict(E_star=E, R=R, eta=ETA, theory=theory, ratios=(1.001,), sigma_trap=sigma_trap)
         base = squeeze_out(T_, p0=p0, **kw)
@@ -172,12 +148,12 @@ def test_rows_next_to_the_trap_pressure_vs_the_tables_reference(name, theory, si
         row = squeeze_out(T_, p0=p0, times=times, **kw).iloc[0]
         assert row["status"] == "ok"
         assert _rel(row["u_inf"] / T_.h_rms, vinf) < 1e-12
-        assert _rel(row["t_star"] / tau, t_ref(0.01 * vinf)) < 1e-6, (x0 - top, "t_star")
-        assert _rel(row["t_ratio_1.001"] / tau, t_ref(1e-3 * vinf)) < 1e-6, (x0 - top, "1.001")
+        assert _rel(row["t_star"] / tau, ref.time(0.01 * vinf)) < 1e-6, (x0 - top, "t_star")
+        assert _rel(row["t_ratio_1.001"] / tau, ref.time(1e-3 * vinf)) < 1e-6, (x0 - top, "1.001")
         for t in times:
             dv = row[column_name("u_at", t)] / T_.h_rms - vinf
             assert dv > 0.0
-            assert abs(tau * t_ref(dv) - t) < 1e-6 * t_rel, (x0 - top, t / t_rel)
+            assert abs(tau * ref.time(dv) - t) < 1e-6 * t_rel, (x0 - top, t / t_rel)
 
 
 # ------------------------------------------------------------------ vs the quadrature
