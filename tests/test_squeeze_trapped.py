@@ -406,3 +406,24 @@ def test_barus_trapped_rows_against_the_reynolds_reference(name):
         ref = squeeze_time(T, "critical_junction", p0[i], E, R, ETA, alpha, vs * h,
                            1.05 * vb * h, vb * h)
         assert abs(got / ref - 1.0) < TOL, (x0[i] - m.x_trap, got, ref)
+
+
+@pytest.mark.parametrize("name", ["asphalt_072mm", "pmma_34um"])
+def test_attrs_say_where_sigma_is_verified(name):
+    """attrs["sigma_verified"] names the p/E* of the tables' last node whose σ̄ lies above the
+    tables' σ̄ floor (read here from the table's own columns), below the trap pressure with
+    the default floor; with a higher trap floor (1e-12) the trap pressure lies below it."""
+    T = Tables.from_parquet(default_table_path(name))
+    floor = float(T.info["sigma_floor"])
+    p = np.asarray(T.data["p_over_E"], dtype=float)
+    for theory in ("critical_junction", "emt"):
+        sig = np.asarray(T.data[f"sigma_{theory}"], dtype=float)
+        p_v = p[np.flatnonzero(sig > floor)[-1]]
+        df = squeeze_out(T, p0=1e5, E_star=E, R=R, eta=ETA, theory=theory)
+        text = df.attrs["sigma_verified"]
+        assert f"p/E* = {p_v:.8g}" in text, (text, p_v)
+        assert p_v < math.exp(squeeze_model(T, theory).x_trap)
+        hi = squeeze_out(T, p0=1e5, E_star=E, R=R, eta=ETA, theory=theory, sigma_trap=1e-12)
+        assert hi.attrs["sigma_verified"].endswith("up to the trap pressure")
+    avg = squeeze_out(T, p0=1e5, E_star=E, R=R, eta=ETA, theory="average")
+    assert avg.attrs["sigma_verified"].endswith("over the whole table")

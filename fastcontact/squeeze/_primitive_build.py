@@ -29,7 +29,7 @@ from ._primitive_eval import (Primitive, _index_map, lagrange_denominators, one_
 
 __all__ = ["build", "measure_error", "profile", "fast_limit", "Profile", "DXI", "Z_LO", "DZ",
            "NODE_POINTS", "THEORY_NODE_POINTS", "node_points", "CHECK_ORDER", "X_END",
-           "X_FALLBACK"]
+           "X_FALLBACK", "verified_top"]
 
 #: grid spacing in ξ = x0 - ln σ̄(x0) of the x0 rows. The rows also carry ln v∞, which the
 #: 4-point stencil keeps within ~4e-9 of the tables' inverse (at 0.15: 2.2e-8, more than the
@@ -379,7 +379,7 @@ def _kink(model):
     return float(lnp[n_open - 1]) if n_open < lnp.size else math.inf
 
 
-def _verified_top(model):
+def verified_top(model):
     """ln p̄ of the tables' last node whose σ̄ lies above the tables' σ̄ floor: the build
     verifies σ̄'s interpolant only between such nodes (beyond it, in the super-exponential
     collapse towards percolation, σ̄ is unverified; the seal engine's trusted top too).
@@ -395,12 +395,12 @@ def _verified_top(model):
 
 def _x_hi(model):
     """ln(p0/E*) of the primitive's last row: X_END below the trap pressure and the tables'
-    kink, and not beyond the tables' last verified node (:func:`_verified_top`). With the
+    kink, and not beyond the tables' last verified node (:func:`verified_top`). With the
     default trap floor (the tables' σ̄ floor) the trap pressure lies in the interval after
     that node, where σ̄ falls by tens of decades (1e-22.5 to 1e-90 on asphalt_072mm): T(x0)
     is only C² across the node, too little for a 4-point stencil, so the rows end there and
     the stencil never straddles it."""
-    return min(model.x_trap - X_END, _kink(model) - X_END, _verified_top(model),
+    return min(model.x_trap - X_END, _kink(model) - X_END, verified_top(model),
                model.x_max)
 
 

@@ -19,7 +19,7 @@ from . import _kernels as qk
 from . import _trap_primitive as tpm
 from ._fastpath import fast_kernel, history_kernel, one_case_primitive, quad_kernel, row_targets
 from .model import DEFAULT_P_START, squeeze_model
-from .primitive import fast_limit
+from .primitive import fast_limit, verified_top
 from ._columns import history_columns, status_flags
 from ..kernels.quadrature import gauss_legendre
 from ..kernels.readonly import readonly_fields
@@ -202,11 +202,26 @@ def attrs(model, cols, method):
                            f"exact percolation at p/E* = "
                            f"{math.exp(xp) if np.isfinite(xp) else math.inf:.8g})"),
         "tail": _tail_text(model),
+        "sigma_verified": _verified_text(model),
         "status": {"ok": "computed", "trapped": "fluid trapped above u_inf (u_trap, t_trap)",
                    "out_of_table": "p0/E_star outside the tables: NaN",
                    "start_below_equilibrium": "u_start <= u_inf: NaN",
                    "overflow": "tau0 or a time not representable in float64 (inf or 0)"},
     }
+
+
+def _verified_text(model):
+    """Provenance text: up to which p/E* the tables' σ̄ is verified (their last node above the
+    tables' σ̄ floor), and what rows beyond it get."""
+    xv = verified_top(model)
+    if not math.isfinite(model.x_trap):
+        return "sigma_bar verified by the table build over the whole table"
+    if xv >= model.x_trap:
+        return "sigma_bar verified by the table build up to the trap pressure"
+    return (f"sigma_bar verified by the table build up to p/E* = {math.exp(xv):.8g} (the tables' "
+            f"last node with sigma_bar above their floor); rows from there to the trap pressure "
+            f"use the tables' unverified sigma_bar (status ok; films there drain over ~1/sigma_bar "
+            f"tau0: treat them as trapped in practice)")
 
 
 def _tail_text(model):

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 from ._primitive_build import (DXI, DZ, NODE_POINTS, X_END, X_FALLBACK, Z_LO,  # noqa: F401
                                PROFILE_DS, PROFILE_FD, Profile, build, fast_limit,
-                               measure_error, profile)
+                               measure_error, profile, verified_top)
 from ._primitive_eval import (Primitive, first_row, row_value, row_value_2,  # noqa: F401
                               stencil, t_of_z, z_of_t)
 from ._primitive_store import (PRIMITIVE_VERSION, load_or_build, primitive_path,  # noqa: F401
