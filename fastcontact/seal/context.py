@@ -16,7 +16,7 @@ from .._core.cache import PerObjectCache
 from ..flow.conductivity import check_theory
 from ..kernels.balance import spread_order
 from ..kernels.quadrature import gauss_legendre
-from ..tables.build import SIGMA_FLOOR
+from ..tables.build import verified_top
 from . import _panels, _sigma
 
 __all__ = ["SealRecord", "SealContext", "seal_context", "PanelRule", "RowsOut", "panel_rule",
@@ -116,23 +116,6 @@ class SealRecord(NamedTuple):
     p_top: float
 
 
-def _trusted_top(tables, theory):
-    """(index, ln π, σ̄) of the table's last node up to which σ̄ is verified.
-
-    The build checks the σ̄ interpolant only between nodes whose σ̄ is above the tables' σ̄
-    floor; past the last such node (the super-exponential collapse before percolation) σ̄ is
-    unverified. "average" is σ̄ = (ū/h_rms)³, verified through ū at every node: its whole
-    table is trusted."""
-    sig = np.asarray(tables.data[f"sigma_{theory}"], dtype=np.float64)
-    if theory == "average":
-        j = sig.size - 1
-    else:
-        floor = float(tables.info.get("sigma_floor", SIGMA_FLOOR))
-        above = np.flatnonzero(sig > floor)
-        j = int(above[-1]) if above.size else 0
-    return j, float(np.log(tables.data["p_over_E"][j])), float(sig[j])
-
-
 def _bucket_map(tn, st0, sh):
     nb = max(int(math.ceil((tn[-1] - st0) / sh)), 1)
     edges = st0 + sh * np.arange(nb + 1)
@@ -185,7 +168,7 @@ class SealContext:
         u_lo = float(np.ravel(tables.mean_separation(np.array([lo]), 1.0))[0]) / self.h_rms
         c_u = float(tables.info["asymptote_u0_over_h"])
         t_top = min(t_hi, t_perc)
-        _, t_trust, sig_trust = _trusted_top(tables, theory)
+        _, t_trust, sig_trust = verified_top(tables, theory)
         t_trust = min(t_trust, t_top)
         self.pi_trust = math.exp(t_trust)
         nret = int(math.floor((t_top - t_lo) / RETAB_H)) + 1

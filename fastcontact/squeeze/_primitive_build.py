@@ -22,14 +22,14 @@ from ..kernels.locate import locate_asc, locate_desc
 from ..kernels.lookup import sigma_interval_resolved, sigma_linear
 from ..kernels.quadrature import gauss_legendre, gauss_lobatto
 from ..kernels.readonly import readonly_fields
-from ..tables.build import SIGMA_FLOOR
+from ..tables.build import verified_top as _tables_verified_top
 from . import _kernels as qk
 from ._primitive_eval import (Primitive, _index_map, lagrange_denominators, one_plus_exp,
                               row_value, stencil, t_of_z)
 
 __all__ = ["build", "measure_error", "profile", "fast_limit", "Profile", "DXI", "Z_LO", "DZ",
            "NODE_POINTS", "THEORY_NODE_POINTS", "node_points", "CHECK_ORDER", "X_END",
-           "X_FALLBACK", "verified_top"]
+           "verified_top"]
 
 #: grid spacing in ξ = x0 - ln σ̄(x0) of the x0 rows. The rows also carry ln v∞, which the
 #: 4-point stencil keeps within ~4e-9 of the tables' inverse (at 0.15: 2.2e-8, more than the
@@ -356,20 +356,19 @@ def profile(model, v_lo):
 
 
 #: rows end X_END below the trap pressure and the tables' kink (:func:`_kink`), and at the
-#: tables' last verified node (:func:`_x_hi`); the primitive serves cases up to
-#: X_FALLBACK below its last row, the per-case quadrature those above (up to the trap
-#: pressure, and between the kink and the trap pressure). Until 2026-12-07 the rows ended
-#: 0.005 below min(trap, kink) and served up to 0.045 below it: with the profile at 0.004 in
-#: ln v, ū − ū∞ deep in the exponential approach and t at ū = 1.001 ū∞ were off the per-case
-#: quadrature by up to 2.4e-6 there. Two causes, both removed: the profile's cubic cells
-#: (t up to 7.6e-7 off 0.002 below the kink of asphalt_024mm at 0.004, 4e-9 at 0.001), and a
-#: 4-point stencil straddling the last table node below the trap (1.9e-6 of T at cell
-#: centres 0.003 below the trap of asphalt_072mm, where σ̄ falls from 1e-22.5 to 1e-90 in
-#: one table interval). Now, on the four embedded tables × (critical junction, EMT), from
-#: 0.06 below the top to the last row: t within 1.7e-8 and ū − ū∞ within 2e-8 of the
-#: quadrature at t* + (0 … 15) t_relax
+#: tables' last verified node (:func:`fast_limit`); the primitive serves cases up to its last
+#: row, the per-case quadrature those above (up to the trap pressure, and between the kink
+#: and the trap pressure). Until 2026-12-07 the rows ended 0.005 below min(trap, kink) and
+#: served up to 0.045 below it: with the profile at 0.004 in ln v, ū − ū∞ deep in the
+#: exponential approach and t at ū = 1.001 ū∞ were off the per-case quadrature by up to
+#: 2.4e-6 there. Two causes, both removed: the profile's cubic cells (t up to 7.6e-7 off
+#: 0.002 below the kink of asphalt_024mm at 0.004, 4e-9 at 0.001), and a 4-point stencil
+#: straddling the last table node below the trap (1.9e-6 of T at cell centres 0.003 below
+#: the trap of asphalt_072mm, where σ̄ falls from 1e-22.5 to 1e-90 in one table interval).
+#: Now, on the four embedded tables × (critical junction, EMT), from 0.06 below the top to
+#: the last row: t within 1.7e-8 and ū − ū∞ within 2e-8 of the quadrature at
+#: t* + (0 … 15) t_relax
 X_END = 1e-4
-X_FALLBACK = 0.0
 
 
 def _kink(model):
@@ -380,33 +379,22 @@ def _kink(model):
 
 
 def verified_top(model):
-    """ln p̄ of the tables' last node whose σ̄ lies above the tables' σ̄ floor: the build
-    verifies σ̄'s interpolant only between such nodes (beyond it, in the super-exponential
-    collapse towards percolation, σ̄ is unverified; the seal engine's trusted top too).
-    inf for a theory without percolation ("average": σ̄ = (ū/h_rms)³, verified through ū at
-    every node, falls below the floor only by ū's own decay)."""
+    """ln p̄ of the tables' last node whose σ̄ the build verified
+    (:func:`fastcontact.tables.build.verified_top`: σ̄ above the tables' σ̄ floor); inf for a
+    theory without percolation ("average", verified at every node)."""
     if not math.isfinite(model.x_perc):
         return math.inf
-    n_open = int(model.tab.n_open)
-    floor = float(model.tables.info.get("sigma_floor", SIGMA_FLOOR))
-    k = int(np.count_nonzero(np.asarray(model.tab.lnsig[:n_open]) > math.log(floor))) - 1
-    return float(model.tab.lnp[k]) if k >= 0 else -math.inf
-
-
-def _x_hi(model):
-    """ln(p0/E*) of the primitive's last row: X_END below the trap pressure and the tables'
-    kink, and not beyond the tables' last verified node (:func:`verified_top`). With the
-    default trap floor (the tables' σ̄ floor) the trap pressure lies in the interval after
-    that node, where σ̄ falls by tens of decades (1e-22.5 to 1e-90 on asphalt_072mm): T(x0)
-    is only C² across the node, too little for a 4-point stencil, so the rows end there and
-    the stencil never straddles it."""
-    return min(model.x_trap - X_END, _kink(model) - X_END, verified_top(model),
-               model.x_max)
+    return _tables_verified_top(model.tables, model.theory)[1]
 
 
 def fast_limit(model):
-    """Largest ln(p0/E*) the primitive serves (above: per-case quadrature)."""
-    return _x_hi(model) - X_FALLBACK
+    """Largest ln(p0/E*) the primitive serves, its last row (above: per-case quadrature):
+    X_END below the trap pressure and the tables' kink, and not beyond the tables' last
+    verified node (:func:`verified_top`). With the default trap floor (the tables' σ̄ floor)
+    the trap pressure lies in the interval after that node, where σ̄ falls by tens of decades
+    (1e-22.5 to 1e-90 on asphalt_072mm): T(x0) is only C² across the node, too little for a
+    4-point stencil, so the rows end there and the stencil never straddles it."""
+    return min(model.x_trap - X_END, _kink(model) - X_END, verified_top(model), model.x_max)
 
 
 @njit(parallel=True, cache=True)
@@ -418,7 +406,7 @@ def _sigma_samples(tab, xs, out):
 
 def _x_nodes(model, dxi):
     """x0 nodes uniform in ξ = x0 - ln σ̄(x0) on [x_min, x_hi]."""
-    x_hi = _x_hi(model)
+    x_hi = fast_limit(model)
     xs = np.linspace(model.x_min, x_hi, 20001)
     sig = np.empty(xs.size)
     _sigma_samples(model.tab, xs, sig)

@@ -26,7 +26,7 @@ __all__ = ["load_or_build", "write", "read", "set_primitive_cache", "primitive_p
 #: 4: z grid spacing 0.2 instead of 0.25; no slope_below column (the slope below the grid
 #: is e^ln_S) (2026-11-27)
 #: 5: profile at 0.001 in ln v; rows up to 1e-4 below the trap pressure and the kink, ending
-#: at the tables' last node below the trap pressure (2026-12-07)
+#: at the tables' last verified node (2026-12-07)
 PRIMITIVE_VERSION = 5
 _CACHE_ATTR = "_squeeze_primitive_dir"
 

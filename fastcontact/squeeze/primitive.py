@@ -27,7 +27,7 @@ when a call has trapped cases.
 """
 from __future__ import annotations
 
-from ._primitive_build import (DXI, DZ, NODE_POINTS, X_END, X_FALLBACK, Z_LO,  # noqa: F401
+from ._primitive_build import (DXI, DZ, NODE_POINTS, X_END, Z_LO,  # noqa: F401
                                PROFILE_DS, PROFILE_FD, Profile, build, fast_limit,
                                measure_error, profile, verified_top)
 from ._primitive_eval import (Primitive, first_row, row_value, row_value_2,  # noqa: F401

@@ -25,7 +25,8 @@ from ..surface.psd import PSD
 from .node_derivatives import NODE_STENCIL, local_derivatives
 from .store import Tables
 
-__all__ = ["precompute", "default_grid", "TOLERANCE", "DEFAULT_POINTS_PER_DECADE", "SIGMA_FLOOR"]
+__all__ = ["precompute", "default_grid", "TOLERANCE", "DEFAULT_POINTS_PER_DECADE", "SIGMA_FLOOR",
+           "verified_top"]
 
 #: default base-grid density in p̄, chosen in bench/tables_results.md ("interpolation error
 #: against build cost", base ppd 2-12 at the default tolerances): the refinement adds what the
@@ -528,3 +529,20 @@ def _check_anisotropy(anisotropy, form, theories, options):
         raise ValueError(f"anisotropy = {anisotropy!r} is invalid with emt_almqvist = True: the "
                          f"broadened P(u) is not implemented for the anisotropic medium")
     return g, form
+
+
+def verified_top(tables, theory):
+    """(index, ln p̄, σ̄) of the tables' last node up to which ``theory``'s σ̄ is verified.
+
+    The build checks the σ̄ interpolant only between nodes whose σ̄ is above the tables' σ̄
+    floor; past the last such node (the super-exponential collapse before percolation) σ̄ is
+    unverified. "average" is σ̄ = (ū/h_rms)³, verified through ū at every node: its whole
+    table is trusted."""
+    sig = np.asarray(tables.data[f"sigma_{theory}"], dtype=np.float64)
+    if theory == "average":
+        j = sig.size - 1
+    else:
+        floor = float(tables.info.get("sigma_floor", SIGMA_FLOOR))
+        above = np.flatnonzero(sig > floor)
+        j = int(above[-1]) if above.size else 0
+    return j, float(np.log(tables.data["p_over_E"][j])), float(sig[j])
